@@ -1,0 +1,160 @@
+//! Simple mechanical systems `M(q) qdd + C(q, qd) qd + dV/dq + D qd = tau`
+//! (paper, eq. 2) and their state-space form `z = (q, qd)`.
+//!
+//! The dimension is a const generic `N` (degrees of freedom) so that the
+//! real-time code works on stack-allocated `nalgebra` matrices. State-space
+//! helpers take a second const `NX` which must equal `2 N` (checked at compile
+//! time), because stable Rust cannot yet write `2 * N` in a type.
+
+mod chain;
+
+pub use chain::{DoublePendulum, PlanarChain, PlanarChainParams};
+
+use nalgebra::{SMatrix, SVector};
+
+/// Configuration-space vector (joint angles, speeds, accelerations or torques).
+pub type Vector<const N: usize> = SVector<f64, N>;
+/// Square configuration-space matrix (inertia, stiffness, Jacobian blocks).
+pub type Matrix<const N: usize> = SMatrix<f64, N, N>;
+
+/// Forward dynamics and its exact first derivatives at one point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DynamicsJacobian<const N: usize> {
+    /// Joint accelerations `qdd`.
+    pub acceleration: Vector<N>,
+    /// `d qdd / d q`.
+    pub d_q: Matrix<N>,
+    /// `d qdd / d qd`.
+    pub d_qd: Matrix<N>,
+    /// `d qdd / d tau` (equals `M(q)^-1`).
+    pub d_tau: Matrix<N>,
+}
+
+/// A simple mechanical system (paper, definition 1) in local coordinates.
+///
+/// Implementors provide the inertia, the potential with its first two
+/// derivatives, the Coriolis/centrifugal forces and exact first derivatives of
+/// the forward dynamics and the energy; everything else (energy, state-space
+/// form, linear modes, eigenmodes, NMPC) is built on these.
+pub trait MechanicalSystem<const N: usize> {
+    /// Inertia matrix `M(q)` (symmetric positive definite).
+    fn mass_matrix(&self, q: &Vector<N>) -> Matrix<N>;
+    /// Potential energy `V(q)`, zero at the stable equilibrium.
+    fn potential(&self, q: &Vector<N>) -> f64;
+    /// Potential forces `dV/dq`.
+    fn potential_gradient(&self, q: &Vector<N>) -> Vector<N>;
+    /// Stiffness `d^2 V / dq^2`.
+    fn potential_hessian(&self, q: &Vector<N>) -> Matrix<N>;
+    /// Coriolis and centrifugal forces `C(q, qd) qd`.
+    fn coriolis_forces(&self, q: &Vector<N>, qd: &Vector<N>) -> Vector<N>;
+    /// Diagonal of the viscous joint damping `D` (zero for the free system).
+    fn damping(&self) -> Vector<N>;
+    /// The stable equilibrium `q_eq` around which modes are defined.
+    fn equilibrium(&self) -> Vector<N>;
+    /// Forward dynamics with exact derivatives w.r.t. `(q, qd, tau)`.
+    fn dynamics_jacobian(
+        &self,
+        q: &Vector<N>,
+        qd: &Vector<N>,
+        tau: &Vector<N>,
+    ) -> DynamicsJacobian<N>;
+    /// Exact gradient of the energy: `(dE/dq, dE/dqd)`.
+    fn energy_gradient(&self, q: &Vector<N>, qd: &Vector<N>) -> (Vector<N>, Vector<N>);
+
+    /// Forward dynamics `qdd = M^-1 (tau - C qd - dV/dq - D qd)`.
+    fn forward_dynamics(&self, q: &Vector<N>, qd: &Vector<N>, tau: &Vector<N>) -> Vector<N> {
+        let rhs = tau
+            - self.coriolis_forces(q, qd)
+            - self.potential_gradient(q)
+            - self.damping().component_mul(qd);
+        solve_spd(&self.mass_matrix(q), &rhs)
+    }
+
+    /// Kinetic energy `1/2 qd' M(q) qd`.
+    fn kinetic_energy(&self, q: &Vector<N>, qd: &Vector<N>) -> f64 {
+        0.5 * qd.dot(&(self.mass_matrix(q) * qd))
+    }
+
+    /// Total energy `E = 1/2 qd' M(q) qd + V(q)` (paper, eq. 3).
+    fn energy(&self, q: &Vector<N>, qd: &Vector<N>) -> f64 {
+        self.kinetic_energy(q, qd) + self.potential(q)
+    }
+}
+
+/// Solves `M x = b` for a symmetric positive definite `M`.
+///
+/// Returns NaN when `M` is not positive definite (only a broken model or a
+/// non-finite state can cause that), so callers see a non-finite result
+/// rather than a panic.
+pub fn solve_spd<const N: usize>(m: &Matrix<N>, b: &Vector<N>) -> Vector<N> {
+    match m.cholesky() {
+        Some(ch) => ch.solve(b),
+        None => Vector::<N>::repeat(f64::NAN),
+    }
+}
+
+/// State `z = (q, qd)` packed into one vector of length `NX = 2 N`.
+pub fn pack_state<const N: usize, const NX: usize>(
+    q: &Vector<N>,
+    qd: &Vector<N>,
+) -> SVector<f64, NX> {
+    const { assert!(NX == 2 * N, "NX must equal 2 N") };
+    let mut z = SVector::<f64, NX>::zeros();
+    z.fixed_rows_mut::<N>(0).copy_from(q);
+    z.fixed_rows_mut::<N>(N).copy_from(qd);
+    z
+}
+
+/// Splits a packed state `z` into `(q, qd)`.
+pub fn unpack_state<const N: usize, const NX: usize>(
+    z: &SVector<f64, NX>,
+) -> (Vector<N>, Vector<N>) {
+    const { assert!(NX == 2 * N, "NX must equal 2 N") };
+    (
+        z.fixed_rows::<N>(0).into_owned(),
+        z.fixed_rows::<N>(N).into_owned(),
+    )
+}
+
+/// State derivative `zd = (qd, qdd)` of the forced system.
+pub fn state_derivative<S, const N: usize, const NX: usize>(
+    system: &S,
+    z: &SVector<f64, NX>,
+    tau: &Vector<N>,
+) -> SVector<f64, NX>
+where
+    S: MechanicalSystem<N> + ?Sized,
+{
+    let (q, qd) = unpack_state::<N, NX>(z);
+    pack_state::<N, NX>(&qd, &system.forward_dynamics(&q, &qd, tau))
+}
+
+/// State derivative with its exact Jacobians `(zd, d zd/d z, d zd/d tau)`.
+pub fn state_jacobian<S, const N: usize, const NX: usize>(
+    system: &S,
+    z: &SVector<f64, NX>,
+    tau: &Vector<N>,
+) -> (SVector<f64, NX>, SMatrix<f64, NX, NX>, SMatrix<f64, NX, N>)
+where
+    S: MechanicalSystem<N> + ?Sized,
+{
+    let (q, qd) = unpack_state::<N, NX>(z);
+    let jac = system.dynamics_jacobian(&q, &qd, tau);
+    let zd = pack_state::<N, NX>(&qd, &jac.acceleration);
+    let mut a = SMatrix::<f64, NX, NX>::zeros();
+    a.fixed_view_mut::<N, N>(0, N).fill_with_identity();
+    a.fixed_view_mut::<N, N>(N, 0).copy_from(&jac.d_q);
+    a.fixed_view_mut::<N, N>(N, N).copy_from(&jac.d_qd);
+    let mut b = SMatrix::<f64, NX, N>::zeros();
+    b.fixed_view_mut::<N, N>(N, 0).copy_from(&jac.d_tau);
+    (zd, a, b)
+}
+
+/// Energy of a packed state.
+pub fn state_energy<S, const N: usize, const NX: usize>(system: &S, z: &SVector<f64, NX>) -> f64
+where
+    S: MechanicalSystem<N> + ?Sized,
+{
+    let (q, qd) = unpack_state::<N, NX>(z);
+    system.energy(&q, &qd)
+}

@@ -1,0 +1,89 @@
+//! The structured QP that one real-time iteration of the multiple-shooting
+//! NMPC produces, and the seam between it and the QP solvers.
+//!
+//! Stage-wise form (all vectors are the *steps* `dx_k`, `du_k` of one SQP
+//! iteration, or absolute values, whichever the caller linearises in):
+//!
+//! ```text
+//! min  sum_{k=0}^{N-1} ( 1/2 [x;u]' [Q_k S_k'; S_k R_k] [x;u] + q_k' x + r_k' u )
+//!        + 1/2 x_N' Q_N x_N + q_N' x_N
+//!        + sum_k sum_i ( soft_l1_i s_ki + 1/2 soft_l2_i s_ki^2 )
+//! s.t. x_0 = x0
+//!      x_{k+1} = A_k x_k + B_k u_k + c_k
+//!      u_lower_k <= u_k <= u_upper_k
+//!      x_lower_k - s_k <= x_k <= x_upper_k + s_k,  s_k >= 0   (soft; +-inf = none)
+//! ```
+//!
+//! Every matrix is allocated once by [`OcpQp::new`] and overwritten in place
+//! at each sample, so the real-time loop does not allocate.
+
+use nalgebra::{DMatrix, DVector};
+
+/// Stage-wise optimal-control QP (see the module documentation).
+#[derive(Clone, Debug)]
+pub struct OcpQp {
+    /// State dimension `nx`.
+    pub nx: usize,
+    /// Control dimension `nu`.
+    pub nu: usize,
+    /// Number of shooting intervals `N`.
+    pub horizon: usize,
+    /// `Q_k`, `k = 0..=N` (`nx x nx`, symmetric PSD).
+    pub q: Vec<DMatrix<f64>>,
+    /// `S_k`, `k = 0..N` (`nu x nx`).
+    pub s: Vec<DMatrix<f64>>,
+    /// `R_k`, `k = 0..N` (`nu x nu`, symmetric PD after regularisation).
+    pub r: Vec<DMatrix<f64>>,
+    /// Linear state cost `q_k`, `k = 0..=N`.
+    pub q_lin: Vec<DVector<f64>>,
+    /// Linear control cost `r_k`, `k = 0..N`.
+    pub r_lin: Vec<DVector<f64>>,
+    /// Dynamics `A_k`, `k = 0..N`.
+    pub a: Vec<DMatrix<f64>>,
+    /// Dynamics `B_k`, `k = 0..N`.
+    pub b: Vec<DMatrix<f64>>,
+    /// Dynamics offset `c_k`, `k = 0..N`.
+    pub c: Vec<DVector<f64>>,
+    /// Initial state (equality constraint on `x_0`).
+    pub x0: DVector<f64>,
+    /// Control lower bounds, `k = 0..N`.
+    pub u_lower: Vec<DVector<f64>>,
+    /// Control upper bounds, `k = 0..N`.
+    pub u_upper: Vec<DVector<f64>>,
+    /// Soft state lower bounds, `k = 0..=N` (`-inf` = none; `x_0` is fixed and its bounds are ignored).
+    pub x_lower: Vec<DVector<f64>>,
+    /// Soft state upper bounds, `k = 0..=N` (`+inf` = none).
+    pub x_upper: Vec<DVector<f64>>,
+    /// Exact-penalty (L1) weight per state component for bound violations.
+    pub soft_l1: DVector<f64>,
+    /// Quadratic weight per state component for bound violations.
+    pub soft_l2: DVector<f64>,
+}
+
+impl OcpQp {
+    /// Allocates a QP with zero data, unbounded controls and no state bounds.
+    pub fn new(nx: usize, nu: usize, horizon: usize) -> Self {
+        let m = |r, c, n| vec![DMatrix::zeros(r, c); n];
+        let v = |r, n, val: f64| vec![DVector::from_element(r, val); n];
+        Self {
+            nx,
+            nu,
+            horizon,
+            q: m(nx, nx, horizon + 1),
+            s: m(nu, nx, horizon),
+            r: m(nu, nu, horizon),
+            q_lin: v(nx, horizon + 1, 0.0),
+            r_lin: v(nu, horizon, 0.0),
+            a: m(nx, nx, horizon),
+            b: m(nx, nu, horizon),
+            c: v(nx, horizon, 0.0),
+            x0: DVector::zeros(nx),
+            u_lower: v(nu, horizon, f64::NEG_INFINITY),
+            u_upper: v(nu, horizon, f64::INFINITY),
+            x_lower: v(nx, horizon + 1, f64::NEG_INFINITY),
+            x_upper: v(nx, horizon + 1, f64::INFINITY),
+            soft_l1: DVector::zeros(nx),
+            soft_l2: DVector::zeros(nx),
+        }
+    }
+}
