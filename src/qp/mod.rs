@@ -87,3 +87,85 @@ impl OcpQp {
         }
     }
 }
+
+/// Outcome of a QP solve.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum QpStatus {
+    /// Solved to the requested tolerances.
+    Solved,
+    /// Solved to reduced tolerances (usable, but say so).
+    AlmostSolved,
+    /// Iteration limit reached; the iterate is returned but not trusted.
+    MaxIterations,
+    /// The QP was proven (primal or dual) infeasible.
+    Infeasible,
+    /// Factorisation or step failure.
+    NumericalError,
+    /// NaN/Inf or inconsistent dimensions in the data; nothing was solved.
+    InvalidInput,
+}
+
+impl QpStatus {
+    /// True when the solution may be applied.
+    pub fn is_usable(self) -> bool {
+        matches!(self, QpStatus::Solved | QpStatus::AlmostSolved)
+    }
+}
+
+/// Primal-dual solution of an [`OcpQp`], preallocated by [`QpSolution::new`].
+///
+/// Multiplier conventions (Lagrangian `L = f + sum_k pi_k' (A_k x_k + B_k u_k +
+/// c_k - x_{k+1}) + ...`): `pi` for the dynamics, `lam_u_lower/upper >= 0` for
+/// the control bounds.
+#[derive(Clone, Debug)]
+pub struct QpSolution {
+    /// States `x_k`, `k = 0..=N`.
+    pub x: Vec<DVector<f64>>,
+    /// Controls `u_k`, `k = 0..N`.
+    pub u: Vec<DVector<f64>>,
+    /// Dynamics multipliers `pi_k`, `k = 0..N`.
+    pub pi: Vec<DVector<f64>>,
+    /// Multipliers of `u_k >= u_lower_k`.
+    pub lam_u_lower: Vec<DVector<f64>>,
+    /// Multipliers of `u_k <= u_upper_k`.
+    pub lam_u_upper: Vec<DVector<f64>>,
+    /// Objective value at the solution.
+    pub objective: f64,
+    /// Interior-point (or other) iterations used.
+    pub iterations: usize,
+    /// Solver status.
+    pub status: QpStatus,
+    /// Infinity norm of the primal residual reported by the solver.
+    pub primal_residual: f64,
+    /// Infinity norm of the dual residual reported by the solver.
+    pub dual_residual: f64,
+}
+
+impl QpSolution {
+    /// Allocates a zero solution of the given dimensions.
+    pub fn new(nx: usize, nu: usize, horizon: usize) -> Self {
+        let v = |r, n| vec![DVector::zeros(r); n];
+        Self {
+            x: v(nx, horizon + 1),
+            u: v(nu, horizon),
+            pi: v(nx, horizon),
+            lam_u_lower: v(nu, horizon),
+            lam_u_upper: v(nu, horizon),
+            objective: 0.0,
+            iterations: 0,
+            status: QpStatus::InvalidInput,
+            primal_residual: f64::INFINITY,
+            dual_residual: f64::INFINITY,
+        }
+    }
+}
+
+/// A solver for [`OcpQp`]s of fixed dimensions, created once and reused at
+/// every sample (its symbolic set-up is done at creation).
+pub trait QpSolver {
+    /// Short name for logs and tables (`"clarabel"`, `"riccati"`).
+    fn name(&self) -> &'static str;
+    /// Solves `qp` into `solution` (overwritten in place); returns the status
+    /// that is also stored in `solution.status`. Never panics on bad data.
+    fn solve(&mut self, qp: &OcpQp, solution: &mut QpSolution) -> QpStatus;
+}
