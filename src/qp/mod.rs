@@ -17,6 +17,8 @@
 //! Every matrix is allocated once by [`OcpQp::new`] and overwritten in place
 //! at each sample, so the real-time loop does not allocate.
 
+pub mod clarabel;
+
 use nalgebra::{DMatrix, DVector};
 
 /// Stage-wise optimal-control QP (see the module documentation).
