@@ -13,4 +13,5 @@
 
 pub mod integrate;
 pub mod mechanics;
+pub mod modes;
 pub mod qp;
