@@ -14,4 +14,5 @@
 pub mod integrate;
 pub mod mechanics;
 pub mod modes;
+pub mod mpc;
 pub mod qp;

@@ -12,9 +12,7 @@
 
 use super::{OcpQp, QpSolution, QpSolver, QpStatus};
 use ::clarabel::algebra::CscMatrix;
-use ::clarabel::solver::{
-    DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
-};
+use ::clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
 
 /// Settings tuned for the RTI QPs: reusable solver (presolve off, structural
 /// zeros kept), no equilibration, no iterative refinement, 1e-6 tolerances
@@ -261,7 +259,12 @@ impl ClarabelQpSolver {
             SupportedConeT::ZeroConeT(m_eq),
             SupportedConeT::NonnegativeConeT(m - m_eq),
         ];
-        let mut layout_vals = (vec![0.0; p_nnz], vec![0.0; a_nnz], vec![0.0; n], vec![0.0; m]);
+        let mut layout_vals = (
+            vec![0.0; p_nnz],
+            vec![0.0; a_nnz],
+            vec![0.0; n],
+            vec![0.0; m],
+        );
         let mut a_fill = a;
         let mut p_fill = p;
         self.fill_p(qp, &pattern, &mut p_fill.nzval);
@@ -354,7 +357,10 @@ impl ClarabelQpSolver {
         for &(r, c, v) in triplets {
             let start = a.colptr[c];
             let end = a.colptr[c + 1];
-            let pos = start + a.rowval[start..end].binary_search(&r).expect("entry in pattern");
+            let pos = start
+                + a.rowval[start..end]
+                    .binary_search(&r)
+                    .expect("entry in pattern");
             a.nzval[pos] = v;
         }
     }
@@ -401,9 +407,7 @@ impl ClarabelQpSolver {
         for (j, &(_, i)) in pattern.soft.iter().enumerate() {
             q[so + j] = qp.soft_l1[i];
         }
-        for i in 0..nx {
-            b[i] = qp.x0[i];
-        }
+        b[..nx].copy_from_slice(qp.x0.as_slice());
         for k in 0..nh {
             for i in 0..nx {
                 b[nx + k * nx + i] = -qp.c[k][i];
@@ -459,7 +463,13 @@ impl ClarabelQpSolver {
         } else {
             let mut layout = self.layout.take().expect("layout present");
             self.fill_p(qp, &layout.pattern, &mut layout.p_val);
-            self.fill_a_values(qp, &layout.pattern, &layout.a_colptr, &layout.a_rowval, &mut layout.a_val);
+            self.fill_a_values(
+                qp,
+                &layout.pattern,
+                &layout.a_colptr,
+                &layout.a_rowval,
+                &mut layout.a_val,
+            );
             self.fill_qb(qp, &layout.pattern, &mut layout.q_val, &mut layout.b_val);
             let s = &mut layout.solver;
             let ok = s.update_P(&layout.p_val).is_ok()
@@ -541,12 +551,31 @@ impl ClarabelQpSolver {
 }
 
 fn data_is_finite(qp: &OcpQp) -> bool {
-    let mats = qp.q.iter().chain(&qp.s).chain(&qp.r).chain(&qp.a).chain(&qp.b);
-    let vecs = qp.q_lin.iter().chain(&qp.r_lin).chain(&qp.c).chain(std::iter::once(&qp.x0));
+    let mats =
+        qp.q.iter()
+            .chain(&qp.s)
+            .chain(&qp.r)
+            .chain(&qp.a)
+            .chain(&qp.b);
+    let vecs = qp
+        .q_lin
+        .iter()
+        .chain(&qp.r_lin)
+        .chain(&qp.c)
+        .chain(std::iter::once(&qp.x0));
     mats.flat_map(|m| m.iter()).all(|v| v.is_finite())
         && vecs.flat_map(|v| v.iter()).all(|v| v.is_finite())
-        && qp.soft_l1.iter().chain(qp.soft_l2.iter()).all(|v| v.is_finite() && *v >= 0.0)
-        && qp.u_lower.iter().chain(&qp.u_upper).chain(&qp.x_lower).chain(&qp.x_upper)
+        && qp
+            .soft_l1
+            .iter()
+            .chain(qp.soft_l2.iter())
+            .all(|v| v.is_finite() && *v >= 0.0)
+        && qp
+            .u_lower
+            .iter()
+            .chain(&qp.u_upper)
+            .chain(&qp.x_lower)
+            .chain(&qp.x_upper)
             .flat_map(|v| v.iter())
             .all(|v| !v.is_nan())
 }
