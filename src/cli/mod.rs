@@ -2,6 +2,7 @@
 //! non-zero exit code, never as a panic trace.
 
 mod modes;
+mod simulate;
 
 use clap::{Args, Parser, Subcommand};
 use eigenmpc::mechanics::{DoublePendulum, PlanarChainParams};
@@ -20,6 +21,8 @@ struct Cli {
 enum Command {
     /// Compute nonlinear eigenmodes (brake orbits) and their charts; prints JSON.
     Modes(modes::ModesArgs),
+    /// Closed loop of the EigenMPC controller against the accurate plant; prints a summary.
+    Simulate(simulate::SimulateArgs),
 }
 
 /// Parameters of the double pendulum (paper, section V).
@@ -93,6 +96,7 @@ pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Modes(args) => modes::run(&args),
+        Command::Simulate(args) => simulate::run_simulate(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
