@@ -127,3 +127,53 @@ fn bad_input_gives_one_line_errors_and_nonzero_exit() {
         assert!(!stderr.contains("panicked"), "{stderr}");
     }
 }
+
+#[test]
+fn fmu_start_values_carry_the_chart_of_the_requested_mode() {
+    let dir = std::env::temp_dir().join(format!("eigenmpc-sv-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("start.json");
+    let file_arg = file.to_str().unwrap();
+    let (code, stdout, stderr) =
+        run(&["modes", "--energies", "14", "--fmu-start-values", file_arg]);
+    assert_eq!(code, 0, "{stderr}");
+    let doc: Value = serde_json::from_str(&stdout).unwrap();
+    let values: Value = serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
+    assert_eq!(values["E_ref"], 14.0);
+    assert_eq!(values["m[1]"], 1.0);
+    assert_eq!(values["g"], 9.81);
+    assert_eq!(values["c[1]"], doc["linear"]["eigenvector"][0]);
+    assert_eq!(values["c[2]"], doc["linear"]["eigenvector"][1]);
+    for j in 0..2 {
+        for k in 0..10 {
+            assert_eq!(
+                values[format!("chart.coef[{},{k}]", j + 1)],
+                doc["modes"][0]["chart"]["coefficients"][j][k]
+            );
+        }
+    }
+    assert_eq!(values.as_object().unwrap().len(), 1 + 5 + 2 + 20);
+    // Lower degree pads with zeros; several energies are refused.
+    let (code, _, _) = run(&[
+        "modes",
+        "--energies",
+        "14",
+        "--degree",
+        "5",
+        "--fmu-start-values",
+        file_arg,
+    ]);
+    assert_eq!(code, 0);
+    let values: Value = serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
+    assert_eq!(values["chart.coef[2,9]"], 0.0);
+    let (code, _, stderr) = run(&[
+        "modes",
+        "--energies",
+        "2,14",
+        "--fmu-start-values",
+        file_arg,
+    ]);
+    assert_ne!(code, 0);
+    assert!(stderr.contains("exactly one energy"), "{stderr}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -26,8 +26,53 @@ pub struct ModesArgs {
     /// Path samples from one turning point to the other.
     #[arg(long, default_value_t = 200)]
     samples: usize,
+    /// Also write the controller FMU's start values (model, eigenvector,
+    /// `E_ref`, chart coefficients) for the single requested energy to FILE,
+    /// as a JSON object `{"variable name": value}` (e.g. for fmpy's
+    /// `simulate_fmu(..., start_values=json.load(f))`).
+    #[arg(long, value_name = "FILE")]
+    fmu_start_values: Option<std::path::PathBuf>,
     #[command(flatten)]
     model: ModelArgs,
+}
+
+/// Polynomial degree of the controller FMU's chart parameters `chart.coef[j,k]`, k = 0..=9.
+pub const FMU_CHART_DEGREE: usize = 9;
+
+/// Start values of the controller FMU for one eigenmode and its chart.
+fn fmu_start_values(
+    model: &ModelArgs,
+    eigenvector: &Vector<2>,
+    energy: f64,
+    chart: &Chart<2>,
+) -> anyhow::Result<serde_json::Map<String, serde_json::Value>> {
+    if chart.degree > FMU_CHART_DEGREE {
+        anyhow::bail!(
+            "--fmu-start-values needs --degree <= {FMU_CHART_DEGREE} (the FMU's chart parameters)"
+        );
+    }
+    let mut values = serde_json::Map::new();
+    let mut put = |name: String, v: f64| {
+        values.insert(name, serde_json::Value::from(v));
+    };
+    put("E_ref".into(), energy);
+    for (name, v) in [
+        ("m[1]", model.m1),
+        ("m[2]", model.m2),
+        ("l[1]", model.l1),
+        ("l[2]", model.l2),
+        ("g", model.g),
+    ] {
+        put(name.into(), v);
+    }
+    for j in 0..2 {
+        put(format!("c[{}]", j + 1), eigenvector[j]);
+        for k in 0..=FMU_CHART_DEGREE {
+            let a = chart.coefficients[j].get(k).copied().unwrap_or(0.0);
+            put(format!("chart.coef[{},{k}]", j + 1), a);
+        }
+    }
+    Ok(values)
 }
 
 #[derive(Serialize)]
@@ -76,6 +121,9 @@ fn vec2(v: &Vector<2>) -> Vec<f64> {
 pub fn run(args: &ModesArgs) -> anyhow::Result<()> {
     let family: Family = args.family.parse().map_err(anyhow::Error::msg)?;
     let energies = parse_list("energies", &args.energies)?;
+    if args.fmu_start_values.is_some() && energies.len() != 1 {
+        anyhow::bail!("--fmu-start-values needs exactly one energy in --energies");
+    }
     if args.samples < 2 * (args.degree + 1) {
         anyhow::bail!(
             "--samples {} is too few for --degree {} (need at least {})",
@@ -112,6 +160,12 @@ pub fn run(args: &ModesArgs) -> anyhow::Result<()> {
         .map(|m| {
             let chart = Chart::fit(&m.path, &linear.eigenvector, &q_eq, args.degree)
                 .with_context(|| format!("chart of the {} J mode", m.energy))?;
+            if let Some(path) = &args.fmu_start_values {
+                let values = fmu_start_values(&args.model, &linear.eigenvector, m.energy, &chart)?;
+                let text = serde_json::to_string_pretty(&values)?;
+                std::fs::write(path, text + "\n")
+                    .with_context(|| format!("writing {}", path.display()))?;
+            }
             let s0 = chart.coordinate(&m.turning_point);
             let s1 = chart.coordinate(&m.other_turning_point);
             Ok(ModeJson {

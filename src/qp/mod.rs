@@ -21,6 +21,14 @@ pub mod clarabel;
 
 use nalgebra::{DMatrix, DVector};
 
+pub mod kkt;
+pub mod record;
+pub mod riccati;
+pub mod synthetic;
+
+pub use kkt::{KktResiduals, kkt_residuals};
+pub use riccati::{RiccatiInfo, RiccatiSettings, RiccatiSolver};
+
 /// Stage-wise optimal-control QP (see the module documentation).
 #[derive(Clone, Debug)]
 pub struct OcpQp {
