@@ -32,6 +32,10 @@
 
 use super::{OcpQp, QpSolution, QpSolver, QpStatus};
 
+mod fixed;
+
+use fixed::FixedCore;
+
 /// Settings of [`RiccatiSolver`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RiccatiSettings {
@@ -111,20 +115,6 @@ trait Dims: Copy {
     #[inline(always)]
     fn m(self) -> usize {
         2 * self.nu() + 3 * self.nx()
-    }
-}
-
-#[derive(Clone, Copy)]
-struct Fixed<const NX: usize, const NU: usize>;
-
-impl<const NX: usize, const NU: usize> Dims for Fixed<NX, NU> {
-    #[inline(always)]
-    fn nx(self) -> usize {
-        NX
-    }
-    #[inline(always)]
-    fn nu(self) -> usize {
-        NU
     }
 }
 
@@ -255,7 +245,17 @@ pub struct RiccatiSolver {
     pub settings: RiccatiSettings,
     info: RiccatiInfo,
     total_regularised: u64,
-    ws: Workspace,
+    engine: Engine,
+}
+
+/// The core for the solver's dimensions: compile-time-sized for the 1-, 2-
+/// and 3-joint chains, runtime-sized otherwise.
+#[derive(Clone, Debug)]
+enum Engine {
+    Runtime(Box<Workspace>),
+    Joints1(Box<FixedCore<2, 1, 8>>),
+    Joints2(Box<FixedCore<4, 2, 16>>),
+    Joints3(Box<FixedCore<6, 3, 24>>),
 }
 
 impl RiccatiSolver {
@@ -269,7 +269,12 @@ impl RiccatiSolver {
             settings,
             info: RiccatiInfo::default(),
             total_regularised: 0,
-            ws: Workspace::new(nx, nu, horizon),
+            engine: match (nx, nu) {
+                (2, 1) => Engine::Joints1(Box::new(FixedCore::new(horizon))),
+                (4, 2) => Engine::Joints2(Box::new(FixedCore::new(horizon))),
+                (6, 3) => Engine::Joints3(Box::new(FixedCore::new(horizon))),
+                _ => Engine::Runtime(Box::new(Workspace::new(nx, nu, horizon))),
+            },
         }
     }
 
@@ -291,20 +296,33 @@ impl RiccatiSolver {
 
     fn run(&mut self, qp: &OcpQp, sol: &mut QpSolution) -> QpStatus {
         let (nx, nu) = (self.nx, self.nu);
-        let mut ipm = Ipm {
-            qp,
-            ws: &mut self.ws,
-            set: &self.settings,
-            n: self.horizon,
-            info: RiccatiInfo::default(),
+        let set = &self.settings;
+        let (status, info) = match &mut self.engine {
+            Engine::Runtime(ws) => {
+                let mut core = Ipm {
+                    qp,
+                    ws,
+                    set,
+                    n: self.horizon,
+                    d: Runtime { nx, nu },
+                    info: RiccatiInfo::default(),
+                };
+                (interior_point(&mut core, set, sol), core.info)
+            }
+            Engine::Joints1(core) => {
+                core.load(qp, set);
+                (interior_point(&mut **core, set, sol), core.info)
+            }
+            Engine::Joints2(core) => {
+                core.load(qp, set);
+                (interior_point(&mut **core, set, sol), core.info)
+            }
+            Engine::Joints3(core) => {
+                core.load(qp, set);
+                (interior_point(&mut **core, set, sol), core.info)
+            }
         };
-        let status = match (nx, nu) {
-            (2, 1) => ipm.solve(Fixed::<2, 1>, sol),
-            (4, 2) => ipm.solve(Fixed::<4, 2>, sol),
-            (6, 3) => ipm.solve(Fixed::<6, 3>, sol),
-            _ => ipm.solve(Runtime { nx, nu }, sol),
-        };
-        self.info = ipm.info;
+        self.info = info;
         self.total_regularised += self.info.regularised_pivots as u64;
         status
     }
@@ -428,6 +446,7 @@ struct Ipm<'a> {
     ws: &'a mut Workspace,
     set: &'a RiccatiSettings,
     n: usize,
+    d: Runtime,
     info: RiccatiInfo,
 }
 
@@ -466,80 +485,143 @@ struct Residuals {
     mu: f64,
 }
 
-impl Ipm<'_> {
-    fn solve<D: Dims>(&mut self, d: D, sol: &mut QpSolution) -> QpStatus {
-        self.initialise(d);
-        let set = *self.set;
-        let mut status = QpStatus::MaxIterations;
-        let mut res = self.residuals(d);
-        let mut iterations = 0;
-        loop {
-            if !(res.stationarity.is_finite() && res.feasibility.is_finite() && res.mu.is_finite())
-            {
-                status = QpStatus::NumericalError;
-                break;
-            }
-            let tol_stat = set
-                .tol_stationarity
-                .max(set.tol_stationarity_relative * res.scale);
-            if res.stationarity <= tol_stat
-                && res.feasibility <= set.tol_feasibility
-                && res.complementarity <= set.tol_complementarity
-            {
-                status = QpStatus::Solved;
-                break;
-            }
-            if iterations >= set.max_iterations {
-                break;
-            }
-            iterations += 1;
-            self.factor(d);
-            // Predictor (affine-scaling) direction.
-            let m_on = self.prepare_affine(d);
-            self.newton_direction(d);
-            let alpha_aff = self.max_step(d, 1.0);
-            let mut alpha = alpha_aff;
-            if m_on > 0 {
-                // Corrector with centring: sigma from the predicted gap.
-                let mu_aff = self.gap_after(d, alpha_aff) / m_on as f64;
-                let sigma = if res.mu > 0.0 {
-                    (mu_aff / res.mu).clamp(0.0, 1.0).powi(3)
-                } else {
-                    0.0
-                };
-                // The centring target never goes far below the tolerance:
-                // smaller t_i only makes the Newton systems ill-conditioned.
-                let target = (sigma * res.mu).max(0.1 * set.tol_complementarity);
-                self.prepare_corrector(d, target);
-                self.newton_direction(d);
-                alpha = self.max_step(d, set.fraction_to_boundary);
-            }
-            if !(alpha.is_finite() && alpha > 0.0) {
-                status = QpStatus::NumericalError;
-                break;
-            }
-            self.take_step(d, alpha);
-            res = self.residuals(d);
-        }
-        if status == QpStatus::MaxIterations
-            && res.stationarity <= set.reduced_tol
-            && res.feasibility <= set.reduced_tol
-            && res.complementarity <= set.reduced_tol
-        {
-            status = QpStatus::AlmostSolved;
-        }
-        self.info.iterations = iterations;
-        self.info.stationarity = res.stationarity;
-        self.info.feasibility = res.feasibility;
-        self.info.complementarity = res.complementarity;
-        self.write_solution(d, sol);
-        sol.iterations = iterations;
-        sol.primal_residual = res.feasibility;
-        sol.dual_residual = res.stationarity;
-        sol.status = status;
-        status
-    }
+/// The steps of one interior-point solve, implemented by the runtime-size
+/// and the compile-time-size cores; the iteration itself is
+/// [`interior_point`].
+trait Core {
+    /// Diagnostics of the solve (pivot counts are added by `factor`).
+    fn info_mut(&mut self) -> &mut RiccatiInfo;
+    /// Starting point.
+    fn initialise(&mut self);
+    /// Residuals of the current iterate (stored for the Newton systems).
+    fn residuals(&mut self) -> Residuals;
+    /// Eliminates the inequalities and factors the Riccati recursion.
+    fn factor(&mut self);
+    /// Predictor right-hand side; returns the number of inequalities.
+    fn prepare_affine(&mut self) -> usize;
+    /// Corrector right-hand side with centring target `sigma_mu`.
+    fn prepare_corrector(&mut self, sigma_mu: f64);
+    /// Newton direction for the current right-hand side and factors.
+    fn newton_direction(&mut self);
+    /// Largest step in (0, 1] keeping `t, lam >= (1 - fraction) * current`.
+    fn max_step(&self, fraction: f64) -> f64;
+    /// Duality gap after a step `alpha`.
+    fn gap_after(&self, alpha: f64) -> f64;
+    /// Moves the iterate by `alpha` times the direction.
+    fn take_step(&mut self, alpha: f64);
+    /// Copies the iterate out and evaluates the objective.
+    fn write_solution(&self, sol: &mut QpSolution);
+}
 
+/// Mehrotra predictor-corrector iteration on any [`Core`].
+fn interior_point<C: Core>(core: &mut C, set: &RiccatiSettings, sol: &mut QpSolution) -> QpStatus {
+    core.initialise();
+    let mut status = QpStatus::MaxIterations;
+    let mut res = core.residuals();
+    let mut iterations = 0;
+    loop {
+        if !(res.stationarity.is_finite() && res.feasibility.is_finite() && res.mu.is_finite()) {
+            status = QpStatus::NumericalError;
+            break;
+        }
+        let tol_stat = set
+            .tol_stationarity
+            .max(set.tol_stationarity_relative * res.scale);
+        if res.stationarity <= tol_stat
+            && res.feasibility <= set.tol_feasibility
+            && res.complementarity <= set.tol_complementarity
+        {
+            status = QpStatus::Solved;
+            break;
+        }
+        if iterations >= set.max_iterations {
+            break;
+        }
+        iterations += 1;
+        core.factor();
+        // Predictor (affine-scaling) direction.
+        let m_on = core.prepare_affine();
+        core.newton_direction();
+        let alpha_aff = core.max_step(1.0);
+        let mut alpha = alpha_aff;
+        if m_on > 0 {
+            // Corrector with centring: sigma from the predicted gap.
+            let mu_aff = core.gap_after(alpha_aff) / m_on as f64;
+            let sigma = if res.mu > 0.0 {
+                (mu_aff / res.mu).clamp(0.0, 1.0).powi(3)
+            } else {
+                0.0
+            };
+            // The centring target never goes far below the tolerance:
+            // smaller t_i only makes the Newton systems ill-conditioned.
+            let target = (sigma * res.mu).max(0.1 * set.tol_complementarity);
+            core.prepare_corrector(target);
+            core.newton_direction();
+            alpha = core.max_step(set.fraction_to_boundary);
+        }
+        if !(alpha.is_finite() && alpha > 0.0) {
+            status = QpStatus::NumericalError;
+            break;
+        }
+        core.take_step(alpha);
+        res = core.residuals();
+    }
+    if status == QpStatus::MaxIterations
+        && res.stationarity <= set.reduced_tol
+        && res.feasibility <= set.reduced_tol
+        && res.complementarity <= set.reduced_tol
+    {
+        status = QpStatus::AlmostSolved;
+    }
+    core.info_mut().iterations = iterations;
+    core.info_mut().stationarity = res.stationarity;
+    core.info_mut().feasibility = res.feasibility;
+    core.info_mut().complementarity = res.complementarity;
+    core.write_solution(sol);
+    sol.iterations = iterations;
+    sol.primal_residual = res.feasibility;
+    sol.dual_residual = res.stationarity;
+    sol.status = status;
+    status
+}
+
+impl Core for Ipm<'_> {
+    fn info_mut(&mut self) -> &mut RiccatiInfo {
+        &mut self.info
+    }
+    fn initialise(&mut self) {
+        Ipm::initialise(self, self.d)
+    }
+    fn residuals(&mut self) -> Residuals {
+        Ipm::residuals(self, self.d)
+    }
+    fn factor(&mut self) {
+        Ipm::factor(self, self.d)
+    }
+    fn prepare_affine(&mut self) -> usize {
+        Ipm::prepare_affine(self, self.d)
+    }
+    fn prepare_corrector(&mut self, sigma_mu: f64) {
+        Ipm::prepare_corrector(self, self.d, sigma_mu)
+    }
+    fn newton_direction(&mut self) {
+        Ipm::newton_direction(self, self.d)
+    }
+    fn max_step(&self, fraction: f64) -> f64 {
+        Ipm::max_step(self, self.d, fraction)
+    }
+    fn gap_after(&self, alpha: f64) -> f64 {
+        Ipm::gap_after(self, self.d, alpha)
+    }
+    fn take_step(&mut self, alpha: f64) {
+        Ipm::take_step(self, self.d, alpha)
+    }
+    fn write_solution(&self, sol: &mut QpSolution) {
+        Ipm::write_solution(self, self.d, sol)
+    }
+}
+
+impl Ipm<'_> {
     /// Marks the existing inequalities and sets a primal point (controls
     /// inside their box, states simulated, slacks covering the violations)
     /// with slacks and multipliers bounded away from zero.
