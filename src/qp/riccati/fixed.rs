@@ -15,7 +15,7 @@
 // nested zips, and the constant bounds let the loops unroll.
 #![allow(clippy::needless_range_loop)]
 
-use super::{Core, Residuals, RiccatiInfo, RiccatiSettings};
+use super::{Core, Residuals, RiccatiInfo, RiccatiSettings, StartShift, add_slot, recentred};
 use crate::qp::{OcpQp, QpSolution};
 use nalgebra::{SMatrix, SVector};
 
@@ -762,5 +762,28 @@ impl<const NX: usize, const NU: usize, const M: usize> Core for FixedCore<NX, NU
             }
         }
         sol.objective = obj;
+    }
+
+    fn recentre(&mut self, shift: &StartShift) {
+        for st in &mut self.st {
+            for i in 0..M {
+                if st.mask[i] > 0.0 {
+                    st.t[i] = recentred(st.t[i], shift.t);
+                    st.lam[i] = recentred(st.lam[i], shift.lam);
+                }
+            }
+        }
+    }
+
+    fn slot_sums(&self) -> (f64, f64, f64, f64, f64) {
+        let mut sums = (f64::INFINITY, f64::INFINITY, 0.0, 0.0, 0.0);
+        for st in &self.st {
+            for i in 0..M {
+                if st.mask[i] > 0.0 {
+                    sums = add_slot(sums, st.t[i], st.lam[i]);
+                }
+            }
+        }
+        sums
     }
 }
