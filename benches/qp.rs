@@ -61,36 +61,20 @@ fn main() {
     let mut linear = Vec::new();
     for &n in &[20, 40, 80, 160, 320] {
         let qps = qp_set(n, n_riccati, 1000 + n as u64);
-        let mut solver = RiccatiSolver::new(4, 2, n, RiccatiSettings::default());
-        let mut sol = QpSolution::new(4, 2, n);
-        // Warm the caches once.
-        solver.solve(&qps[0], &mut sol);
-        let (mut times, mut iters, mut worst_kkt) = (Vec::new(), Vec::new(), 0.0f64);
-        let mut failed = 0;
-        let mut per_stage_iter = Vec::new();
-        for qp in &qps {
-            let start = Instant::now();
-            let status = solver.solve(black_box(qp), &mut sol);
-            times.push(start.elapsed().as_secs_f64() * 1e3);
-            if !status.is_usable() {
-                failed += 1;
-                eprintln!("riccati N = {n}: {status:?} {:?}", solver.info());
-                continue;
+        // The default (Mehrotra start) and the plain start, for comparison.
+        let plain = RiccatiSettings {
+            mehrotra_start: false,
+            ..Default::default()
+        };
+        for (name, settings) in [
+            ("riccati", RiccatiSettings::default()),
+            ("riccati (plain start)", plain),
+        ] {
+            let per_stage = riccati_row(n, name, settings, &qps);
+            if name == "riccati" {
+                linear.push((n, per_stage));
             }
-            iters.push(sol.iterations);
-            per_stage_iter.push(
-                times.last().copied().unwrap_or(0.0) * 1e6 / (n * sol.iterations.max(1)) as f64,
-            );
-            let kkt = kkt_residuals(qp, &sol);
-            // Stationarity relative to its round-off scale when that is large.
-            let stat = kkt.stationarity / kkt.stationarity_scale.max(1.0);
-            worst_kkt = worst_kkt
-                .max(stat)
-                .max(kkt.primal_feasibility)
-                .max(kkt.complementarity);
         }
-        print_row(n, "riccati", stats(times), &iters, worst_kkt, failed);
-        linear.push((n, stats(per_stage_iter).median));
 
         let (mut times, mut iters, mut failed) = (Vec::new(), Vec::new(), 0);
         for qp in qps.iter().take(n_clarabel) {
@@ -119,6 +103,40 @@ fn main() {
     for (n, t) in linear {
         println!("| {n} | {t:.0} |");
     }
+}
+
+/// Times the Riccati solver on `qps`, prints the row and returns the median
+/// time per iteration per stage (ns).
+fn riccati_row(n: usize, name: &str, settings: RiccatiSettings, qps: &[OcpQp]) -> f64 {
+    let mut solver = RiccatiSolver::new(4, 2, n, settings);
+    let mut sol = QpSolution::new(4, 2, n);
+    // Warm the caches once.
+    solver.solve(&qps[0], &mut sol);
+    let (mut times, mut iters, mut worst_kkt) = (Vec::new(), Vec::new(), 0.0f64);
+    let mut failed = 0;
+    let mut per_stage_iter = Vec::new();
+    for qp in qps {
+        let start = Instant::now();
+        let status = solver.solve(black_box(qp), &mut sol);
+        times.push(start.elapsed().as_secs_f64() * 1e3);
+        if !status.is_usable() {
+            failed += 1;
+            eprintln!("{name} N = {n}: {status:?} {:?}", solver.info());
+            continue;
+        }
+        iters.push(sol.iterations);
+        per_stage_iter
+            .push(times.last().copied().unwrap_or(0.0) * 1e6 / (n * sol.iterations.max(1)) as f64);
+        let kkt = kkt_residuals(qp, &sol);
+        // Stationarity relative to its round-off scale when that is large.
+        let stat = kkt.stationarity / kkt.stationarity_scale.max(1.0);
+        worst_kkt = worst_kkt
+            .max(stat)
+            .max(kkt.primal_feasibility)
+            .max(kkt.complementarity);
+    }
+    print_row(n, name, stats(times), &iters, worst_kkt, failed);
+    stats(per_stage_iter).median
 }
 
 fn print_row(n: usize, name: &str, s: Stats, iters: &[usize], kkt: f64, failed: usize) {

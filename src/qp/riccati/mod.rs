@@ -32,6 +32,10 @@
 
 use super::{OcpQp, QpSolution, QpSolver, QpStatus};
 
+mod fixed;
+
+use fixed::FixedCore;
+
 /// Settings of [`RiccatiSolver`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RiccatiSettings {
@@ -60,6 +64,11 @@ pub struct RiccatiSettings {
     /// the largest term of the stationarity sums (round-off floor when the
     /// costate is large).
     pub tol_stationarity_relative: f64,
+    /// Start from Mehrotra's point (one Newton step from the plain start,
+    /// then shifted into the interior; counted as an iteration). Fewer
+    /// iterations and no stalls on long horizons with unstable
+    /// linearisations; `false` keeps the plain start.
+    pub mehrotra_start: bool,
 }
 
 impl Default for RiccatiSettings {
@@ -76,6 +85,7 @@ impl Default for RiccatiSettings {
             initial_slack: 1.0,
             initial_multiplier: 1.0,
             tol_stationarity_relative: 1e-14,
+            mehrotra_start: true,
         }
     }
 }
@@ -111,20 +121,6 @@ trait Dims: Copy {
     #[inline(always)]
     fn m(self) -> usize {
         2 * self.nu() + 3 * self.nx()
-    }
-}
-
-#[derive(Clone, Copy)]
-struct Fixed<const NX: usize, const NU: usize>;
-
-impl<const NX: usize, const NU: usize> Dims for Fixed<NX, NU> {
-    #[inline(always)]
-    fn nx(self) -> usize {
-        NX
-    }
-    #[inline(always)]
-    fn nu(self) -> usize {
-        NU
     }
 }
 
@@ -255,7 +251,17 @@ pub struct RiccatiSolver {
     pub settings: RiccatiSettings,
     info: RiccatiInfo,
     total_regularised: u64,
-    ws: Workspace,
+    engine: Engine,
+}
+
+/// The core for the solver's dimensions: compile-time-sized for the 1-, 2-
+/// and 3-joint chains, runtime-sized otherwise.
+#[derive(Clone, Debug)]
+enum Engine {
+    Runtime(Box<Workspace>),
+    Joints1(Box<FixedCore<2, 1, 8>>),
+    Joints2(Box<FixedCore<4, 2, 16>>),
+    Joints3(Box<FixedCore<6, 3, 24>>),
 }
 
 impl RiccatiSolver {
@@ -269,7 +275,12 @@ impl RiccatiSolver {
             settings,
             info: RiccatiInfo::default(),
             total_regularised: 0,
-            ws: Workspace::new(nx, nu, horizon),
+            engine: match (nx, nu) {
+                (2, 1) => Engine::Joints1(Box::new(FixedCore::new(horizon))),
+                (4, 2) => Engine::Joints2(Box::new(FixedCore::new(horizon))),
+                (6, 3) => Engine::Joints3(Box::new(FixedCore::new(horizon))),
+                _ => Engine::Runtime(Box::new(Workspace::new(nx, nu, horizon))),
+            },
         }
     }
 
@@ -291,20 +302,33 @@ impl RiccatiSolver {
 
     fn run(&mut self, qp: &OcpQp, sol: &mut QpSolution) -> QpStatus {
         let (nx, nu) = (self.nx, self.nu);
-        let mut ipm = Ipm {
-            qp,
-            ws: &mut self.ws,
-            set: &self.settings,
-            n: self.horizon,
-            info: RiccatiInfo::default(),
+        let set = &self.settings;
+        let (status, info) = match &mut self.engine {
+            Engine::Runtime(ws) => {
+                let mut core = Ipm {
+                    qp,
+                    ws,
+                    set,
+                    n: self.horizon,
+                    d: Runtime { nx, nu },
+                    info: RiccatiInfo::default(),
+                };
+                (interior_point(&mut core, set, sol), core.info)
+            }
+            Engine::Joints1(core) => {
+                core.load(qp, set);
+                (interior_point(&mut **core, set, sol), core.info)
+            }
+            Engine::Joints2(core) => {
+                core.load(qp, set);
+                (interior_point(&mut **core, set, sol), core.info)
+            }
+            Engine::Joints3(core) => {
+                core.load(qp, set);
+                (interior_point(&mut **core, set, sol), core.info)
+            }
         };
-        let status = match (nx, nu) {
-            (2, 1) => ipm.solve(Fixed::<2, 1>, sol),
-            (4, 2) => ipm.solve(Fixed::<4, 2>, sol),
-            (6, 3) => ipm.solve(Fixed::<6, 3>, sol),
-            _ => ipm.solve(Runtime { nx, nu }, sol),
-        };
-        self.info = ipm.info;
+        self.info = info;
         self.total_regularised += self.info.regularised_pivots as u64;
         status
     }
@@ -428,6 +452,7 @@ struct Ipm<'a> {
     ws: &'a mut Workspace,
     set: &'a RiccatiSettings,
     n: usize,
+    d: Runtime,
     info: RiccatiInfo,
 }
 
@@ -466,80 +491,218 @@ struct Residuals {
     mu: f64,
 }
 
-impl Ipm<'_> {
-    fn solve<D: Dims>(&mut self, d: D, sol: &mut QpSolution) -> QpStatus {
-        self.initialise(d);
-        let set = *self.set;
-        let mut status = QpStatus::MaxIterations;
-        let mut res = self.residuals(d);
-        let mut iterations = 0;
-        loop {
-            if !(res.stationarity.is_finite() && res.feasibility.is_finite() && res.mu.is_finite())
-            {
-                status = QpStatus::NumericalError;
-                break;
-            }
-            let tol_stat = set
-                .tol_stationarity
-                .max(set.tol_stationarity_relative * res.scale);
-            if res.stationarity <= tol_stat
-                && res.feasibility <= set.tol_feasibility
-                && res.complementarity <= set.tol_complementarity
-            {
-                status = QpStatus::Solved;
-                break;
-            }
-            if iterations >= set.max_iterations {
-                break;
-            }
-            iterations += 1;
-            self.factor(d);
-            // Predictor (affine-scaling) direction.
-            let m_on = self.prepare_affine(d);
-            self.newton_direction(d);
-            let alpha_aff = self.max_step(d, 1.0);
-            let mut alpha = alpha_aff;
-            if m_on > 0 {
-                // Corrector with centring: sigma from the predicted gap.
-                let mu_aff = self.gap_after(d, alpha_aff) / m_on as f64;
-                let sigma = if res.mu > 0.0 {
-                    (mu_aff / res.mu).clamp(0.0, 1.0).powi(3)
-                } else {
-                    0.0
-                };
-                // The centring target never goes far below the tolerance:
-                // smaller t_i only makes the Newton systems ill-conditioned.
-                let target = (sigma * res.mu).max(0.1 * set.tol_complementarity);
-                self.prepare_corrector(d, target);
-                self.newton_direction(d);
-                alpha = self.max_step(d, set.fraction_to_boundary);
-            }
-            if !(alpha.is_finite() && alpha > 0.0) {
-                status = QpStatus::NumericalError;
-                break;
-            }
-            self.take_step(d, alpha);
-            res = self.residuals(d);
-        }
-        if status == QpStatus::MaxIterations
-            && res.stationarity <= set.reduced_tol
-            && res.feasibility <= set.reduced_tol
-            && res.complementarity <= set.reduced_tol
-        {
-            status = QpStatus::AlmostSolved;
-        }
-        self.info.iterations = iterations;
-        self.info.stationarity = res.stationarity;
-        self.info.feasibility = res.feasibility;
-        self.info.complementarity = res.complementarity;
-        self.write_solution(d, sol);
-        sol.iterations = iterations;
-        sol.primal_residual = res.feasibility;
-        sol.dual_residual = res.stationarity;
-        sol.status = status;
-        status
-    }
+/// The steps of one interior-point solve, implemented by the runtime-size
+/// and the compile-time-size cores; the iteration itself is
+/// [`interior_point`].
+trait Core {
+    /// Diagnostics of the solve (pivot counts are added by `factor`).
+    fn info_mut(&mut self) -> &mut RiccatiInfo;
+    /// Starting point.
+    fn initialise(&mut self);
+    /// Residuals of the current iterate (stored for the Newton systems).
+    fn residuals(&mut self) -> Residuals;
+    /// Eliminates the inequalities and factors the Riccati recursion.
+    fn factor(&mut self);
+    /// Predictor right-hand side; returns the number of inequalities.
+    fn prepare_affine(&mut self) -> usize;
+    /// Corrector right-hand side with centring target `sigma_mu`.
+    fn prepare_corrector(&mut self, sigma_mu: f64);
+    /// Newton direction for the current right-hand side and factors.
+    fn newton_direction(&mut self);
+    /// Largest step in (0, 1] keeping `t, lam >= (1 - fraction) * current`.
+    fn max_step(&self, fraction: f64) -> f64;
+    /// Duality gap after a step `alpha`.
+    fn gap_after(&self, alpha: f64) -> f64;
+    /// Moves the iterate by `alpha` times the direction.
+    fn take_step(&mut self, alpha: f64);
+    /// Copies the iterate out and evaluates the objective.
+    fn write_solution(&self, sol: &mut QpSolution);
+    /// Moves the slacks and multipliers of the existing inequalities back
+    /// into the interior after the starting Newton step: `v <- max(v, 0) +
+    /// shift` (see [`StartShift`]).
+    fn recentre(&mut self, shift: &StartShift);
+    /// Sums over the existing inequalities: (min t, min lam, t'lam, sum t,
+    /// sum lam).
+    fn slot_sums(&self) -> (f64, f64, f64, f64, f64);
+}
 
+/// Uniform shifts of the starting slacks and multipliers (Mehrotra 1992,
+/// as in OOQP): first enough to make them positive, then half the average
+/// complementarity so that no product starts far from the others.
+#[derive(Clone, Copy, Debug)]
+struct StartShift {
+    t: f64,
+    lam: f64,
+}
+
+/// Mehrotra predictor-corrector iteration on any [`Core`].
+fn interior_point<C: Core>(core: &mut C, set: &RiccatiSettings, sol: &mut QpSolution) -> QpStatus {
+    core.initialise();
+    let mut status = QpStatus::MaxIterations;
+    let mut res = core.residuals();
+    let mut iterations = 0;
+    if set.mehrotra_start
+        && res.stationarity.is_finite()
+        && res.feasibility.is_finite()
+        && set.max_iterations > 0
+    {
+        // Mehrotra's starting point: one full Newton (affine-scaling) step
+        // makes the equalities hold and gives the multipliers the scale of
+        // the costate (|pi| ~ 1e7 on unstable linearisations, where a
+        // start on the scale of the cost gradient stalls); the slacks and
+        // multipliers are then shifted back into the interior.
+        iterations += 1;
+        core.factor();
+        core.prepare_affine();
+        core.newton_direction();
+        core.take_step(1.0);
+        let (min_t, min_lam, _, _, _) = core.slot_sums();
+        let shift = StartShift {
+            t: (-1.5 * min_t).max(0.0),
+            lam: (-1.5 * min_lam).max(0.0),
+        };
+        core.recentre(&shift);
+        let (_, _, tl, sum_t, sum_lam) = core.slot_sums();
+        if sum_t > 0.0 && sum_lam > 0.0 {
+            core.recentre(&StartShift {
+                t: 0.5 * tl / sum_lam,
+                lam: 0.5 * tl / sum_t,
+            });
+        }
+        res = core.residuals();
+    }
+    loop {
+        if !(res.stationarity.is_finite() && res.feasibility.is_finite() && res.mu.is_finite()) {
+            status = QpStatus::NumericalError;
+            break;
+        }
+        let tol_stat = set
+            .tol_stationarity
+            .max(set.tol_stationarity_relative * res.scale);
+        if res.stationarity <= tol_stat
+            && res.feasibility <= set.tol_feasibility
+            && res.complementarity <= set.tol_complementarity
+        {
+            status = QpStatus::Solved;
+            break;
+        }
+        if iterations >= set.max_iterations {
+            break;
+        }
+        iterations += 1;
+        core.factor();
+        // Predictor (affine-scaling) direction.
+        let m_on = core.prepare_affine();
+        core.newton_direction();
+        let alpha_aff = core.max_step(1.0);
+        let mut alpha = alpha_aff;
+        if m_on > 0 {
+            // Corrector with centring: sigma from the predicted gap.
+            let mu_aff = core.gap_after(alpha_aff) / m_on as f64;
+            let sigma = if res.mu > 0.0 {
+                (mu_aff / res.mu).clamp(0.0, 1.0).powi(3)
+            } else {
+                0.0
+            };
+            // The centring target never goes far below the tolerance:
+            // smaller t_i only makes the Newton systems ill-conditioned.
+            let target = (sigma * res.mu).max(0.1 * set.tol_complementarity);
+            core.prepare_corrector(target);
+            core.newton_direction();
+            alpha = core.max_step(set.fraction_to_boundary);
+        }
+        if !(alpha.is_finite() && alpha > 0.0) {
+            status = QpStatus::NumericalError;
+            break;
+        }
+        core.take_step(alpha);
+        res = core.residuals();
+    }
+    if status == QpStatus::MaxIterations
+        && res.stationarity <= set.reduced_tol
+        && res.feasibility <= set.reduced_tol
+        && res.complementarity <= set.reduced_tol
+    {
+        status = QpStatus::AlmostSolved;
+    }
+    core.info_mut().iterations = iterations;
+    core.info_mut().stationarity = res.stationarity;
+    core.info_mut().feasibility = res.feasibility;
+    core.info_mut().complementarity = res.complementarity;
+    core.write_solution(sol);
+    sol.iterations = iterations;
+    sol.primal_residual = res.feasibility;
+    sol.dual_residual = res.stationarity;
+    sol.status = status;
+    status
+}
+
+impl Core for Ipm<'_> {
+    fn info_mut(&mut self) -> &mut RiccatiInfo {
+        &mut self.info
+    }
+    fn initialise(&mut self) {
+        Ipm::initialise(self, self.d)
+    }
+    fn residuals(&mut self) -> Residuals {
+        Ipm::residuals(self, self.d)
+    }
+    fn factor(&mut self) {
+        Ipm::factor(self, self.d)
+    }
+    fn prepare_affine(&mut self) -> usize {
+        Ipm::prepare_affine(self, self.d)
+    }
+    fn prepare_corrector(&mut self, sigma_mu: f64) {
+        Ipm::prepare_corrector(self, self.d, sigma_mu)
+    }
+    fn newton_direction(&mut self) {
+        Ipm::newton_direction(self, self.d)
+    }
+    fn max_step(&self, fraction: f64) -> f64 {
+        Ipm::max_step(self, self.d, fraction)
+    }
+    fn gap_after(&self, alpha: f64) -> f64 {
+        Ipm::gap_after(self, self.d, alpha)
+    }
+    fn take_step(&mut self, alpha: f64) {
+        Ipm::take_step(self, self.d, alpha)
+    }
+    fn write_solution(&self, sol: &mut QpSolution) {
+        Ipm::write_solution(self, self.d, sol)
+    }
+    fn recentre(&mut self, shift: &StartShift) {
+        let ws = &mut *self.ws;
+        for idx in 0..ws.t.len() {
+            if ws.on[idx] {
+                ws.t[idx] = recentred(ws.t[idx], shift.t);
+                ws.lam[idx] = recentred(ws.lam[idx], shift.lam);
+            }
+        }
+    }
+    fn slot_sums(&self) -> (f64, f64, f64, f64, f64) {
+        let ws = &*self.ws;
+        let mut sums = (f64::INFINITY, f64::INFINITY, 0.0, 0.0, 0.0);
+        for idx in 0..ws.t.len() {
+            if ws.on[idx] {
+                sums = add_slot(sums, ws.t[idx], ws.lam[idx]);
+            }
+        }
+        sums
+    }
+}
+
+/// `max(v, 0) + shift`.
+fn recentred(v: f64, shift: f64) -> f64 {
+    v.max(0.0) + shift
+}
+
+/// Accumulates one slot into [`Core::slot_sums`].
+fn add_slot(s: (f64, f64, f64, f64, f64), t: f64, lam: f64) -> (f64, f64, f64, f64, f64) {
+    (s.0.min(t), s.1.min(lam), s.2 + t * lam, s.3 + t, s.4 + lam)
+}
+
+impl Ipm<'_> {
     /// Marks the existing inequalities and sets a primal point (controls
     /// inside their box, states simulated, slacks covering the violations)
     /// with slacks and multipliers bounded away from zero.

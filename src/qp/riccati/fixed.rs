@@ -1,0 +1,789 @@
+//! Compile-time-sized core of the Riccati interior point for the common
+//! chain sizes: the stage data is copied once per solve into contiguous
+//! per-stage blocks of nalgebra static matrices, absent inequalities are
+//! switched off by 0/1 masks instead of per-slot branches, and the passes
+//! over the horizon are fused (gradient assembly into the backward sweep,
+//! slack and multiplier recovery and the step-length ratio test into the
+//! forward sweep). Same mathematics as the runtime-size core in the parent
+//! module (see its documentation for the formulation).
+//!
+//! Slot layout of a stage's `M = 2 NU + 3 NX` inequalities: `u - u_lower`
+//! (`0..NU`), `u_upper - u` (`NU..2NU`), `x + s - x_lower`, `x_upper + s - x`,
+//! `s` (`NX` each).
+
+// The kernels walk several parallel per-slot arrays by index: clearer than
+// nested zips, and the constant bounds let the loops unroll.
+#![allow(clippy::needless_range_loop)]
+
+use super::{Core, Residuals, RiccatiInfo, RiccatiSettings, StartShift, add_slot, recentred};
+use crate::qp::{OcpQp, QpSolution};
+use nalgebra::{SMatrix, SVector};
+
+type Mat<const R: usize, const C: usize> = SMatrix<f64, R, C>;
+type Vecn<const R: usize> = SVector<f64, R>;
+
+/// Data, iterate, residuals, factors and direction of one stage.
+#[derive(Clone, Debug)]
+struct Stage<const NX: usize, const NU: usize, const M: usize> {
+    // Data (zero where a stage has no such block, e.g. `A_N`).
+    a: Mat<NX, NX>,
+    b: Mat<NX, NU>,
+    c: Vecn<NX>,
+    q: Mat<NX, NX>,
+    s: Mat<NU, NX>,
+    r: Mat<NU, NU>,
+    ql: Vecn<NX>,
+    rl: Vecn<NU>,
+    /// Constraint offsets: slot value = `D z + off` (0 for absent slots).
+    off: [f64; M],
+    /// 1 for an existing slot, 0 otherwise.
+    mask: [f64; M],
+    /// 1 for a soft state component, 0 otherwise.
+    soft: Vecn<NX>,
+    // Iterate.
+    x: Vecn<NX>,
+    u: Vecn<NU>,
+    sl: Vecn<NX>,
+    pi: Vecn<NX>,
+    t: [f64; M],
+    lam: [f64; M],
+    /// `1 / t` and `1 / lam` on existing slots, 0 elsewhere (set by
+    /// `factor`: divisions are the slowest operations of the kernels).
+    inv_t: [f64; M],
+    inv_lam: [f64; M],
+    // Residuals.
+    ru: Vecn<NU>,
+    re: Vecn<NX>,
+    rx: Vecn<NX>,
+    rs: Vecn<NX>,
+    rp: [f64; M],
+    rc: [f64; M],
+    // Eliminated inequalities and slacks.
+    diag_u: Vecn<NU>,
+    diag_x: Vecn<NX>,
+    cross: Vecn<NX>,
+    hss: Vecn<NX>,
+    inv_hss: Vecn<NX>,
+    coef_l: Vecn<NX>,
+    coef_u: Vecn<NX>,
+    // Factor of M_k = [Luu 0; Lxu Lxx] [Luu 0; Lxu Lxx]'.
+    luu: Mat<NU, NU>,
+    lxu: Mat<NX, NU>,
+    lxx: Mat<NX, NX>,
+    inv_u: Vecn<NU>,
+    // Newton direction.
+    gu: Vecn<NU>,
+    gx: Vecn<NX>,
+    gs: Vecn<NX>,
+    p: Vecn<NX>,
+    yu: Vecn<NU>,
+    dx: Vecn<NX>,
+    du: Vecn<NU>,
+    ds: Vecn<NX>,
+    dpi: Vecn<NX>,
+    dt: [f64; M],
+    dlam: [f64; M],
+}
+
+impl<const NX: usize, const NU: usize, const M: usize> Stage<NX, NU, M> {
+    fn zeroed() -> Self {
+        let (m0, mx, vx, vu) = ([0.0; M], Mat::zeros(), Vecn::zeros(), Vecn::zeros());
+        Self {
+            a: mx,
+            b: Mat::zeros(),
+            c: vx,
+            q: mx,
+            s: Mat::zeros(),
+            r: Mat::zeros(),
+            ql: vx,
+            rl: vu,
+            off: m0,
+            mask: m0,
+            soft: vx,
+            x: vx,
+            u: vu,
+            sl: vx,
+            pi: vx,
+            t: m0,
+            lam: m0,
+            inv_t: m0,
+            inv_lam: m0,
+            ru: vu,
+            re: vx,
+            rx: vx,
+            rs: vx,
+            rp: m0,
+            rc: m0,
+            diag_u: vu,
+            diag_x: vx,
+            cross: vx,
+            hss: vx,
+            inv_hss: vx,
+            coef_l: vx,
+            coef_u: vx,
+            luu: Mat::zeros(),
+            lxu: Mat::zeros(),
+            lxx: mx,
+            inv_u: vu,
+            gu: vu,
+            gx: vx,
+            gs: vx,
+            p: vx,
+            yu: vu,
+            dx: vx,
+            du: vu,
+            ds: vx,
+            dpi: vx,
+            dt: m0,
+            dlam: m0,
+        }
+    }
+
+    /// Slot values `D z + off` at the current iterate.
+    #[inline(always)]
+    fn constraint_values(&self) -> [f64; M] {
+        let mut v = [0.0; M];
+        for j in 0..NU {
+            v[j] = self.u[j] + self.off[j];
+            v[NU + j] = self.off[NU + j] - self.u[j];
+        }
+        for i in 0..NX {
+            let (x, s) = (self.x[i], self.sl[i]);
+            v[2 * NU + i] = x + s + self.off[2 * NU + i];
+            v[2 * NU + NX + i] = s - x + self.off[2 * NU + NX + i];
+            v[2 * NU + 2 * NX + i] = s;
+        }
+        v
+    }
+
+    /// `w = (rc + lam rp) / t` on existing slots (the Newton system's
+    /// inequality term of the gradient).
+    #[inline(always)]
+    fn slot_gradient(&self) -> [f64; M] {
+        let mut w = [0.0; M];
+        for i in 0..M {
+            w[i] = (self.rc[i] + self.lam[i] * self.rp[i]) * self.inv_t[i];
+        }
+        w
+    }
+
+    /// Slack and multiplier directions of the inequalities from `dx`, `du`
+    /// (and `gs`); returns the smallest ratio `-v / dv` over decreasing
+    /// slacks and multipliers (infinite when none decreases).
+    #[inline(always)]
+    fn recover(&mut self) -> f64 {
+        let inv_hss = self.inv_hss;
+        let mut dc = [0.0; M];
+        for j in 0..NU {
+            dc[j] = self.du[j];
+            dc[NU + j] = -self.du[j];
+        }
+        for i in 0..NX {
+            // dx + ds and ds - dx formed without cancelling the large terms
+            // of an active bound (they must be accurate relative to t).
+            let (dx, gs, h) = (self.dx[i], self.gs[i], inv_hss[i]);
+            let ds = -(gs + self.cross[i] * dx) * h;
+            self.ds[i] = ds;
+            dc[2 * NU + i] = (self.coef_l[i] * dx - gs) * h;
+            dc[2 * NU + NX + i] = (-self.coef_u[i] * dx - gs) * h;
+            dc[2 * NU + 2 * NX + i] = ds;
+        }
+        // Largest relative decrease -dv / v; its inverse is the ratio.
+        let mut decrease = 0.0f64;
+        for i in 0..M {
+            let dt = self.mask[i] * (dc[i] + self.rp[i]);
+            let dlam = -(self.rc[i] + self.lam[i] * dt) * self.inv_t[i];
+            self.dt[i] = dt;
+            self.dlam[i] = dlam;
+            decrease = fmax(fmax(decrease, -dt * self.inv_t[i]), -dlam * self.inv_lam[i]);
+        }
+        1.0 / decrease
+    }
+}
+
+/// Workspace and iterate of the compile-time-sized core (allocated once).
+#[derive(Clone, Debug)]
+pub(super) struct FixedCore<const NX: usize, const NU: usize, const M: usize> {
+    st: Vec<Stage<NX, NU, M>>,
+    n: usize,
+    l1: Vecn<NX>,
+    l2: Vecn<NX>,
+    x0: Vecn<NX>,
+    /// Number of existing inequality slots.
+    m_on: usize,
+    /// Smallest step ratio of the last direction.
+    ratio: f64,
+    set: RiccatiSettings,
+    pub(super) info: RiccatiInfo,
+}
+
+impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
+    pub(super) fn new(horizon: usize) -> Self {
+        assert_eq!(M, 2 * NU + 3 * NX, "slot count of the fixed core");
+        Self {
+            st: vec![Stage::zeroed(); horizon + 1],
+            n: horizon,
+            l1: Vecn::zeros(),
+            l2: Vecn::zeros(),
+            x0: Vecn::zeros(),
+            m_on: 0,
+            ratio: f64::INFINITY,
+            set: RiccatiSettings::default(),
+            info: RiccatiInfo::default(),
+        }
+    }
+
+    /// Copies the (validated) QP into the stage blocks and marks the
+    /// existing inequalities.
+    pub(super) fn load(&mut self, qp: &OcpQp, set: &RiccatiSettings) {
+        let n = self.n;
+        self.set = *set;
+        self.info = RiccatiInfo::default();
+        let copy = |dst: &mut [f64], src: &[f64]| dst.copy_from_slice(src);
+        copy(self.l1.as_mut_slice(), qp.soft_l1.as_slice());
+        copy(self.l2.as_mut_slice(), qp.soft_l2.as_slice());
+        copy(self.x0.as_mut_slice(), qp.x0.as_slice());
+        let mut m_on = 0.0;
+        for (k, st) in self.st.iter_mut().enumerate() {
+            copy(st.q.as_mut_slice(), qp.q[k].as_slice());
+            copy(st.ql.as_mut_slice(), qp.q_lin[k].as_slice());
+            st.mask = [0.0; M];
+            st.off = [0.0; M];
+            if k < n {
+                copy(st.a.as_mut_slice(), qp.a[k].as_slice());
+                copy(st.b.as_mut_slice(), qp.b[k].as_slice());
+                copy(st.c.as_mut_slice(), qp.c[k].as_slice());
+                copy(st.s.as_mut_slice(), qp.s[k].as_slice());
+                copy(st.r.as_mut_slice(), qp.r[k].as_slice());
+                copy(st.rl.as_mut_slice(), qp.r_lin[k].as_slice());
+                let (lo, hi) = (&qp.u_lower[k], &qp.u_upper[k]);
+                for j in 0..NU {
+                    if lo[j].is_finite() {
+                        st.mask[j] = 1.0;
+                        st.off[j] = -lo[j];
+                    }
+                    if hi[j].is_finite() {
+                        st.mask[NU + j] = 1.0;
+                        st.off[NU + j] = hi[j];
+                    }
+                }
+            }
+            st.soft = Vecn::zeros();
+            if k >= 1 {
+                let (lo, hi) = (&qp.x_lower[k], &qp.x_upper[k]);
+                for i in 0..NX {
+                    // A bound whose weights are both zero costs nothing to
+                    // violate: ignored (as in the KKT checker).
+                    let weighted = self.l1[i] > 0.0 || self.l2[i] > 0.0;
+                    let (fl, fh) = (lo[i].is_finite(), hi[i].is_finite());
+                    if weighted && (fl || fh) {
+                        st.soft[i] = 1.0;
+                        st.mask[2 * NU + 2 * NX + i] = 1.0;
+                        if fl {
+                            st.mask[2 * NU + i] = 1.0;
+                            st.off[2 * NU + i] = -lo[i];
+                        }
+                        if fh {
+                            st.mask[2 * NU + NX + i] = 1.0;
+                            st.off[2 * NU + NX + i] = hi[i];
+                        }
+                    }
+                }
+            }
+            m_on += st.mask.iter().sum::<f64>();
+        }
+        self.m_on = m_on as usize;
+    }
+
+    /// Lower Cholesky factor in place with the parent module's pivot rules:
+    /// pivots not clearly positive are lifted by `lift` (control block) or,
+    /// with `lift = None`, truncated to a zero column (state block).
+    /// `diag` holds the original diagonal for the relative pivot threshold.
+    /// Returns the number of lifted or truncated pivots.
+    #[inline(always)]
+    fn cholesky<const D: usize>(
+        m: &mut Mat<D, D>,
+        inv: &mut Vecn<D>,
+        diag: &Vecn<D>,
+        lift: Option<f64>,
+        tol: f64,
+    ) -> usize {
+        let mut count = 0;
+        for j in 0..D {
+            let mut djj = m[(j, j)];
+            for c in 0..j {
+                djj -= m[(j, c)] * m[(j, c)];
+            }
+            let threshold = tol * diag[j].abs().max(f64::MIN_POSITIVE);
+            if djj.is_nan() || djj <= threshold {
+                count += 1;
+                match lift {
+                    Some(l) => djj = djj.max(0.0) + l,
+                    None => {
+                        for i in j..D {
+                            m[(i, j)] = 0.0;
+                            m[(j, i)] = 0.0;
+                        }
+                        inv[j] = 0.0;
+                        continue;
+                    }
+                }
+            }
+            let ljj = djj.sqrt();
+            let r = 1.0 / ljj;
+            m[(j, j)] = ljj;
+            // The factor is used as a full matrix: clear the upper triangle.
+            for c in j + 1..D {
+                m[(j, c)] = 0.0;
+            }
+            inv[j] = r;
+            for i in j + 1..D {
+                let mut v = m[(i, j)];
+                for c in 0..j {
+                    v -= m[(i, c)] * m[(j, c)];
+                }
+                m[(i, j)] = v * r;
+            }
+        }
+        count
+    }
+}
+
+/// Maximum by one comparison (`f64::max` spends several instructions on
+/// NaN rules; NaN is detected separately with [`nan_probe`]).
+#[inline(always)]
+fn fmax(a: f64, b: f64) -> f64 {
+    if b > a { b } else { a }
+}
+
+/// 0 for a finite `v`, NaN otherwise: summed over the residuals it tells
+/// whether any of them is not finite.
+#[inline(always)]
+fn nan_probe(v: f64) -> f64 {
+    v * 0.0
+}
+
+/// `L (L' v)` for a lower-triangular `L` (the cost-to-go Hessian times `v`).
+#[inline(always)]
+fn llt_mul<const NX: usize>(l: &Mat<NX, NX>, v: &Vecn<NX>) -> Vecn<NX> {
+    l * l.tr_mul(v)
+}
+
+impl<const NX: usize, const NU: usize, const M: usize> Core for FixedCore<NX, NU, M> {
+    fn info_mut(&mut self) -> &mut RiccatiInfo {
+        &mut self.info
+    }
+
+    fn initialise(&mut self) {
+        let n = self.n;
+        let t0 = self.set.initial_slack;
+        // Multipliers on the scale of the cost gradient: too small ones let
+        // the first steps run far out of the box and stall.
+        let mut lam0 = 1.0f64;
+        for st in &self.st {
+            lam0 = lam0.max(st.ql.amax()).max(st.rl.amax());
+        }
+        lam0 *= self.set.initial_multiplier;
+        self.st[0].x = self.x0;
+        for k in 0..=n {
+            let st = &mut self.st[k];
+            st.pi = Vecn::zeros();
+            st.sl = Vecn::zeros();
+            st.u = Vecn::zeros();
+            if k < n {
+                for j in 0..NU {
+                    let (lo, hi) = (st.mask[j] > 0.0, st.mask[NU + j] > 0.0);
+                    let (l, h) = (-st.off[j], st.off[NU + j]);
+                    st.u[j] = match (lo, hi) {
+                        (true, true) => 0.5 * (l + h),
+                        (true, false) => l.max(0.0),
+                        (false, true) => h.min(0.0),
+                        (false, false) => 0.0,
+                    };
+                }
+                // Simulate so the dynamics hold at the start.
+                let next = st.a * st.x + st.b * st.u + st.c;
+                self.st[k + 1].x = next;
+            }
+            let st = &mut self.st[k];
+            if k >= 1 {
+                for i in 0..NX {
+                    if st.soft[i] > 0.0 {
+                        let xv = st.x[i];
+                        let mut viol = 0.0f64;
+                        if st.mask[2 * NU + i] > 0.0 {
+                            viol = viol.max(-st.off[2 * NU + i] - xv);
+                        }
+                        if st.mask[2 * NU + NX + i] > 0.0 {
+                            viol = viol.max(xv - st.off[2 * NU + NX + i]);
+                        }
+                        st.sl[i] = viol + t0;
+                    }
+                }
+            }
+            let cv = st.constraint_values();
+            for i in 0..M {
+                if st.mask[i] > 0.0 {
+                    st.t[i] = cv[i].max(t0);
+                    st.lam[i] = lam0 / st.t[i];
+                } else {
+                    st.t[i] = 1.0;
+                    st.lam[i] = 0.0;
+                }
+            }
+        }
+    }
+
+    fn residuals(&mut self) -> Residuals {
+        let n = self.n;
+        let (mut stat, mut scale, mut feas) = (0.0f64, 0.0f64, 0.0f64);
+        let (mut gap, mut comp, mut probe) = (0.0, 0.0f64, 0.0);
+        let (l1, l2) = (self.l1, self.l2);
+        for k in 0..=n {
+            let pi_prev = if k > 0 {
+                self.st[k - 1].pi
+            } else {
+                Vecn::zeros()
+            };
+            let x_next = if k < n {
+                self.st[k + 1].x
+            } else {
+                Vecn::zeros()
+            };
+            let st = &mut self.st[k];
+            let (ll, lu) = (&st.lam[..NU], &st.lam[NU..2 * NU]);
+            if k < n {
+                let h = st.r * st.u + st.s * st.x;
+                let e = st.b.tr_mul(&st.pi);
+                for j in 0..NU {
+                    let v = st.rl[j] + h[j] + e[j] - ll[j] + lu[j];
+                    let terms = fmax(fmax(st.rl[j].abs(), h[j].abs()), e[j].abs());
+                    scale = fmax(scale, fmax(terms, fmax(ll[j], lu[j])));
+                    st.ru[j] = v;
+                    stat = fmax(stat, v.abs());
+                    probe += nan_probe(v);
+                }
+                st.re = st.a * st.x + st.b * st.u + st.c - x_next;
+                for i in 0..NX {
+                    feas = fmax(feas, st.re[i].abs());
+                    probe += nan_probe(st.re[i]);
+                }
+            }
+            if k >= 1 {
+                // x_0 is fixed: its row is not a condition.
+                let h = st.q * st.x + st.s.tr_mul(&st.u);
+                let e = st.a.tr_mul(&st.pi);
+                let (xl, xu, xs) = (
+                    &st.lam[2 * NU..2 * NU + NX],
+                    &st.lam[2 * NU + NX..2 * NU + 2 * NX],
+                    &st.lam[2 * NU + 2 * NX..],
+                );
+                for i in 0..NX {
+                    let prev = pi_prev[i];
+                    let v = st.ql[i] + h[i] + e[i] - prev - xl[i] + xu[i];
+                    let terms = fmax(fmax(st.ql[i].abs(), h[i].abs()), e[i].abs());
+                    scale = fmax(scale, fmax(fmax(terms, prev.abs()), fmax(xl[i], xu[i])));
+                    st.rx[i] = v;
+                    let w = st.soft[i] * (l1[i] + l2[i] * st.sl[i] - xl[i] - xu[i] - xs[i]);
+                    st.rs[i] = w;
+                    stat = fmax(stat, fmax(v.abs(), w.abs()));
+                    probe += nan_probe(v) + nan_probe(w);
+                }
+            }
+            let cv = st.constraint_values();
+            for i in 0..M {
+                let r = st.mask[i] * (cv[i] - st.t[i]);
+                st.rp[i] = r;
+                feas = fmax(feas, r.abs());
+                let tl = st.t[i] * st.lam[i];
+                gap += tl;
+                comp = fmax(comp, tl);
+            }
+        }
+        Residuals {
+            // NaN anywhere makes the residual NaN (the iteration stops).
+            stationarity: stat + probe,
+            scale,
+            feasibility: feas,
+            complementarity: comp,
+            mu: if self.m_on > 0 {
+                gap / self.m_on as f64
+            } else {
+                0.0
+            },
+        }
+    }
+
+    fn factor(&mut self) {
+        let n = self.n;
+        let set = self.set;
+        let l2 = self.l2;
+        let (mut regularised, mut truncated) = (0, 0);
+        for k in (0..=n).rev() {
+            let lnext = if k < n {
+                self.st[k + 1].lxx
+            } else {
+                Mat::zeros()
+            };
+            let st = &mut self.st[k];
+            let mut sig = [0.0; M];
+            for i in 0..M {
+                let on = st.mask[i] > 0.0;
+                st.inv_t[i] = if on { 1.0 / st.t[i] } else { 0.0 };
+                st.inv_lam[i] = if on { 1.0 / st.lam[i] } else { 0.0 };
+                sig[i] = st.lam[i] * st.inv_t[i];
+            }
+            for j in 0..NU {
+                st.diag_u[j] = sig[j] + sig[NU + j];
+            }
+            for i in 0..NX {
+                if st.soft[i] > 0.0 {
+                    let a = sig[2 * NU + i];
+                    let b = sig[2 * NU + NX + i];
+                    let h = l2[i] + sig[2 * NU + 2 * NX + i];
+                    let hss = a + b + h;
+                    st.hss[i] = hss;
+                    st.inv_hss[i] = 1.0 / hss;
+                    st.cross[i] = a - b;
+                    st.coef_l[i] = 2.0 * b + h;
+                    st.coef_u[i] = 2.0 * a + h;
+                    // (a + b) - (a - b)^2 / (a + b + h) without cancellation.
+                    st.diag_x[i] = (4.0 * a * b + (a + b) * h) / hss;
+                } else {
+                    st.hss[i] = 1.0;
+                    st.inv_hss[i] = 1.0;
+                    st.cross[i] = 0.0;
+                    st.coef_l[i] = 0.0;
+                    st.coef_u[i] = 0.0;
+                    st.diag_x[i] = 0.0;
+                }
+            }
+            let mut inv_x = Vecn::<NX>::zeros();
+            if k == n {
+                // Terminal stage: P_N = Q_N + diag.
+                let mut mxx = st.q;
+                for i in 0..NX {
+                    mxx[(i, i)] += st.diag_x[i];
+                }
+                let diag = mxx.diagonal();
+                truncated += Self::cholesky(&mut mxx, &mut inv_x, &diag, None, set.pivot_tolerance);
+                st.lxx = mxx;
+                continue;
+            }
+            // M = [R S; S' Q] + diag + [B A]' L L' [B A]; at k = 0 only the
+            // control block is needed (x_0 is fixed).
+            let bl = st.b.tr_mul(&lnext);
+            let mut muu = st.r + bl * bl.transpose();
+            for j in 0..NU {
+                muu[(j, j)] += st.diag_u[j];
+            }
+            let du = muu.diagonal();
+            let (mut mxx, mut mxu, dx) = if k > 0 {
+                let al = st.a.tr_mul(&lnext);
+                let mut mxx = st.q + al * al.transpose();
+                for i in 0..NX {
+                    mxx[(i, i)] += st.diag_x[i];
+                }
+                let mxu = st.s.transpose() + al * bl.transpose();
+                let dx = mxx.diagonal();
+                (mxx, mxu, dx)
+            } else {
+                (Mat::zeros(), Mat::zeros(), Vecn::zeros())
+            };
+            let mut scale = du.max();
+            if k > 0 {
+                scale = scale.max(dx.max());
+            }
+            if scale.is_nan() || scale <= 0.0 {
+                scale = 1.0;
+            }
+            regularised += Self::cholesky(
+                &mut muu,
+                &mut st.inv_u,
+                &du,
+                Some(set.regularisation * scale),
+                set.pivot_tolerance,
+            );
+            st.luu = muu;
+            if k > 0 {
+                // Lxu = Mxu Luu^{-T}, then the Schur complement's factor.
+                for j in 0..NU {
+                    for c in 0..j {
+                        let l = muu[(j, c)];
+                        for i in 0..NX {
+                            mxu[(i, j)] -= mxu[(i, c)] * l;
+                        }
+                    }
+                    let r = st.inv_u[j];
+                    for i in 0..NX {
+                        mxu[(i, j)] *= r;
+                    }
+                }
+                mxx -= mxu * mxu.transpose();
+                truncated += Self::cholesky(&mut mxx, &mut inv_x, &dx, None, set.pivot_tolerance);
+                st.lxu = mxu;
+                st.lxx = mxx;
+            }
+        }
+        self.info.regularised_pivots += regularised;
+        self.info.truncated_pivots += truncated;
+    }
+
+    fn prepare_affine(&mut self) -> usize {
+        for st in &mut self.st {
+            for i in 0..M {
+                st.rc[i] = st.t[i] * st.lam[i];
+            }
+        }
+        self.m_on
+    }
+
+    fn prepare_corrector(&mut self, sigma_mu: f64) {
+        for st in &mut self.st {
+            for i in 0..M {
+                st.rc[i] = st.mask[i] * (st.t[i] * st.lam[i] + st.dt[i] * st.dlam[i] - sigma_mu);
+            }
+        }
+    }
+
+    fn newton_direction(&mut self) {
+        let n = self.n;
+        // Backward sweep with the gradient assembly: p_N = g_N; p_k = g_x +
+        // A' v - Lxu yu with v = P_{k+1} c_k + p_{k+1}, yu = Luu^{-1} (g_u + B' v).
+        let mut p_next = Vecn::<NX>::zeros();
+        let mut l_next = Mat::<NX, NX>::zeros();
+        for k in (0..=n).rev() {
+            let st = &mut self.st[k];
+            let w = st.slot_gradient();
+            for j in 0..NU {
+                st.gu[j] = st.ru[j] + w[j] - w[NU + j];
+            }
+            for i in 0..NX {
+                let (wl, wu) = (w[2 * NU + i], w[2 * NU + NX + i]);
+                let gs = st.soft[i] * (st.rs[i] + wl + wu + w[2 * NU + 2 * NX + i]);
+                st.gs[i] = gs;
+                st.gx[i] = st.rx[i] + wl - wu - st.cross[i] * gs * st.inv_hss[i];
+            }
+            if k == n {
+                st.p = st.gx;
+            } else {
+                let v = llt_mul(&l_next, &st.re) + p_next;
+                let g = st.gu + st.b.tr_mul(&v);
+                for j in 0..NU {
+                    let mut y = g[j];
+                    for c in 0..j {
+                        y -= st.luu[(j, c)] * st.yu[c];
+                    }
+                    st.yu[j] = y * st.inv_u[j];
+                }
+                if k > 0 {
+                    st.p = st.gx + st.a.tr_mul(&v) - st.lxu * st.yu;
+                }
+            }
+            p_next = st.p;
+            l_next = st.lxx;
+        }
+        // Forward sweep with the recovery of the inequality directions.
+        let mut ratio = f64::INFINITY;
+        let mut dx = Vecn::<NX>::zeros();
+        for k in 0..=n {
+            let (head, tail) = self.st.split_at_mut(k + 1);
+            let st = &mut head[k];
+            st.dx = dx;
+            if k < n {
+                // du = -Luu^{-T} (Lxu' dx + yu)
+                let rhs = st.lxu.tr_mul(&dx) + st.yu;
+                for j in (0..NU).rev() {
+                    let mut v = rhs[j];
+                    for c in j + 1..NU {
+                        v += st.luu[(c, j)] * st.du[c];
+                    }
+                    st.du[j] = -v * st.inv_u[j];
+                }
+                dx = st.a * dx + st.b * st.du + st.re;
+                let next = &tail[0];
+                st.dpi = llt_mul(&next.lxx, &dx) + next.p;
+            }
+            ratio = ratio.min(st.recover());
+        }
+        self.ratio = ratio;
+    }
+
+    fn max_step(&self, fraction: f64) -> f64 {
+        (fraction * self.ratio).min(1.0)
+    }
+
+    fn gap_after(&self, alpha: f64) -> f64 {
+        let mut gap = 0.0;
+        for st in &self.st {
+            for i in 0..M {
+                gap += (st.t[i] + alpha * st.dt[i]) * (st.lam[i] + alpha * st.dlam[i]);
+            }
+        }
+        gap
+    }
+
+    fn take_step(&mut self, alpha: f64) {
+        for (k, st) in self.st.iter_mut().enumerate() {
+            if k > 0 {
+                st.x += alpha * st.dx;
+            }
+            st.u += alpha * st.du;
+            st.sl += alpha * st.ds;
+            st.pi += alpha * st.dpi;
+            for i in 0..M {
+                st.t[i] += alpha * st.dt[i];
+                st.lam[i] += alpha * st.dlam[i];
+            }
+        }
+    }
+
+    fn write_solution(&self, sol: &mut QpSolution) {
+        let n = self.n;
+        let (l1, l2) = (self.l1, self.l2);
+        let mut obj = 0.0;
+        for (k, st) in self.st.iter().enumerate() {
+            sol.x[k].as_mut_slice().copy_from_slice(st.x.as_slice());
+            obj += 0.5 * st.x.dot(&(st.q * st.x)) + st.ql.dot(&st.x);
+            if k < n {
+                sol.u[k].as_mut_slice().copy_from_slice(st.u.as_slice());
+                sol.pi[k].as_mut_slice().copy_from_slice(st.pi.as_slice());
+                sol.lam_u_lower[k]
+                    .as_mut_slice()
+                    .copy_from_slice(&st.lam[..NU]);
+                sol.lam_u_upper[k]
+                    .as_mut_slice()
+                    .copy_from_slice(&st.lam[NU..2 * NU]);
+                obj += st.u.dot(&(0.5 * (st.r * st.u) + st.s * st.x + st.rl));
+            }
+            for i in 0..NX {
+                let s = st.sl[i];
+                obj += st.soft[i] * (l1[i] * s + 0.5 * l2[i] * s * s);
+            }
+        }
+        sol.objective = obj;
+    }
+
+    fn recentre(&mut self, shift: &StartShift) {
+        for st in &mut self.st {
+            for i in 0..M {
+                if st.mask[i] > 0.0 {
+                    st.t[i] = recentred(st.t[i], shift.t);
+                    st.lam[i] = recentred(st.lam[i], shift.lam);
+                }
+            }
+        }
+    }
+
+    fn slot_sums(&self) -> (f64, f64, f64, f64, f64) {
+        let mut sums = (f64::INFINITY, f64::INFINITY, 0.0, 0.0, 0.0);
+        for st in &self.st {
+            for i in 0..M {
+                if st.mask[i] > 0.0 {
+                    sums = add_slot(sums, st.t[i], st.lam[i]);
+                }
+            }
+        }
+        sums
+    }
+}
