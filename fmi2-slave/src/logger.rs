@@ -8,7 +8,7 @@
 
 use crate::ffi;
 use std::cell::Cell;
-use std::ffi::{CString, c_char};
+use std::ffi::CString;
 
 /// Log categories of the FMU (`<LogCategories>` of the model description).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -183,17 +183,18 @@ impl Logger {
         let Some(callback) = self.callback else {
             return;
         };
-        let message = to_cstring(message);
+        // The message is the printf format: '%' escaped, no variadic
+        // arguments, so hosts that format and hosts that print the raw
+        // string both show the text.
+        let message = to_cstring(&message.replace('%', "%%"));
         let category = to_cstring(c.name());
-        // SAFETY: the host promised a valid logger in fmi2Instantiate; the
-        // message goes through "%s" so '%' in it is not interpreted.
+        // SAFETY: the host promised a valid logger in fmi2Instantiate.
         unsafe {
             callback(
                 self.environment,
                 self.instance_name.as_ptr(),
                 status.to_ffi(),
                 category.as_ptr(),
-                c"%s".as_ptr() as *const c_char,
                 message.as_ptr(),
             );
         }

@@ -2,7 +2,7 @@
 //! FMU through its C functions in tests.
 
 use crate::ffi;
-use std::ffi::{CStr, c_char, c_void};
+use std::ffi::{CStr, c_void};
 use std::sync::Mutex;
 
 /// One message the FMU sent to the host.
@@ -23,18 +23,17 @@ pub struct LogCapture {
     lines: Mutex<Vec<LogLine>>,
 }
 
-/// Receives the "%s" + message form [`crate::Logger`] always uses. Rust
-/// cannot define C-variadic functions on stable; for integer and pointer
-/// arguments the variadic and non-variadic C calling conventions agree on the
-/// supported 64-bit Linux targets, so this non-variadic callee reads the
-/// message correctly. Only for FMUs built on this crate.
+/// Receives the messages of [`crate::Logger`], which passes no variadic
+/// arguments (the message is the format, '%' escaped). Rust cannot define
+/// C-variadic functions on stable; with no variadic arguments the variadic
+/// and non-variadic C calling conventions agree for these pointer and integer
+/// arguments on the supported 64-bit targets. Only for FMUs built on this crate.
 unsafe extern "C" fn capture(
     environment: ffi::fmi2ComponentEnvironment,
     _instance_name: ffi::fmi2String,
     status: ffi::fmi2Status,
     category: ffi::fmi2String,
-    _format: ffi::fmi2String,
-    message: *const c_char,
+    message: ffi::fmi2String,
 ) {
     // SAFETY: environment is the LogCapture passed in `callbacks`; strings
     // are NUL-terminated by the Logger.
@@ -43,7 +42,7 @@ unsafe extern "C" fn capture(
         let line = LogLine {
             status,
             category: CStr::from_ptr(category).to_string_lossy().into_owned(),
-            message: CStr::from_ptr(message).to_string_lossy().into_owned(),
+            message: CStr::from_ptr(message).to_string_lossy().replace("%%", "%"),
         };
         if let Ok(mut lines) = capture.lines.lock() {
             lines.push(line);
@@ -51,13 +50,12 @@ unsafe extern "C" fn capture(
     }
 }
 
-type SixArgLogger = unsafe extern "C" fn(
+type FixedArgLogger = unsafe extern "C" fn(
     ffi::fmi2ComponentEnvironment,
     ffi::fmi2String,
     ffi::fmi2Status,
     ffi::fmi2String,
     ffi::fmi2String,
-    *const c_char,
 );
 
 impl LogCapture {
@@ -72,7 +70,7 @@ impl LogCapture {
         // the Logger passes.
         let logger: ffi::fmi2CallbackLogger = Some(unsafe {
             std::mem::transmute::<
-                SixArgLogger,
+                FixedArgLogger,
                 unsafe extern "C" fn(
                     ffi::fmi2ComponentEnvironment,
                     ffi::fmi2String,

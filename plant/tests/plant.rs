@@ -236,14 +236,11 @@ fn invalid_parameters_and_inputs_are_rejected() {
     );
 }
 
-/// Directory of the built libraries (target/<profile>), from this test's path.
-fn profile_dir() -> PathBuf {
-    let exe = std::env::current_exe().unwrap();
-    exe.parent().unwrap().parent().unwrap().to_path_buf()
-}
-
+/// The cdylib cargo built for this test run: next to the test executable in
+/// target/<profile>/deps (`cargo test` does not copy it up to target/<profile>).
 fn library() -> PathBuf {
-    let lib = profile_dir().join("libdouble_pendulum_fmu.so");
+    let exe = std::env::current_exe().unwrap();
+    let lib = exe.parent().unwrap().join("libdouble_pendulum_fmu.so");
     assert!(lib.exists(), "{} not built", lib.display());
     lib
 }
