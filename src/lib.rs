@@ -13,4 +13,6 @@
 
 pub mod integrate;
 pub mod mechanics;
+pub mod modes;
+pub mod mpc;
 pub mod qp;

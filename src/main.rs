@@ -1,1 +1,7 @@
-fn main() {}
+//! `eigenmpc`: command-line front end (eigenmodes, closed-loop simulation).
+
+mod cli;
+
+fn main() -> std::process::ExitCode {
+    cli::main()
+}

@@ -17,7 +17,17 @@
 //! Every matrix is allocated once by [`OcpQp::new`] and overwritten in place
 //! at each sample, so the real-time loop does not allocate.
 
+pub mod clarabel;
+
 use nalgebra::{DMatrix, DVector};
+
+pub mod kkt;
+pub mod record;
+pub mod riccati;
+pub mod synthetic;
+
+pub use kkt::{KktResiduals, kkt_residuals};
+pub use riccati::{RiccatiInfo, RiccatiSettings, RiccatiSolver};
 
 /// Stage-wise optimal-control QP (see the module documentation).
 #[derive(Clone, Debug)]

@@ -1,0 +1,120 @@
+//! Benchmark of the EigenMPC control step (issue 3): per-sample compute time
+//! in closed loop on the paper's 14 J scenarios, split into preparation
+//! (shift + RK4 sensitivities + residual Jacobians + QP assembly) and
+//! feedback (QP solve and step), and its growth with the horizon N.
+//!
+//! `cargo run --release --bin bench_mpc [-- --duration 30]`. Prints
+//! markdown tables. The first sample (converged SQP from a cold start) is
+//! reported separately and excluded from the per-sample statistics.
+
+use eigenmpc::mechanics::DoublePendulum;
+use eigenmpc::modes::linear_modes;
+use eigenmpc::mpc::closed_loop::{Sample, mode_and_chart, quantile, run};
+use eigenmpc::mpc::{Controller, MpcConfig, Reference, Variant};
+use nalgebra::SVector;
+
+fn stats(mut v: Vec<f64>) -> [f64; 4] {
+    v.sort_by(f64::total_cmp);
+    [
+        quantile(&v, 0.5),
+        quantile(&v, 0.95),
+        quantile(&v, 0.99),
+        *v.last().unwrap_or(&f64::NAN),
+    ]
+}
+
+fn ms(x: [f64; 4]) -> String {
+    format!(
+        "{:.3} | {:.3} | {:.3} | {:.3}",
+        x[0] * 1e3,
+        x[1] * 1e3,
+        x[2] * 1e3,
+        x[3] * 1e3
+    )
+}
+
+fn run_case(variant: Variant, horizon: usize, duration: f64) -> Vec<Sample<2, 4>> {
+    let sys = DoublePendulum::default();
+    let reference = match variant {
+        Variant::Straight => Reference::Straight {
+            eigenvector: linear_modes(&sys).expect("linear modes")[0].eigenvector,
+        },
+        Variant::Curved => {
+            let (_, chart) = mode_and_chart::<_, 2, 4>(&sys, 0, 14.0, 9).expect("14 J mode");
+            Reference::Curved(chart)
+        }
+    };
+    let mut config = MpcConfig::paper(variant);
+    config.horizon = horizon;
+    // Keep the simulated dynamics identical across N: same sample period.
+    let mut ctrl = Controller::<_, 2, 4>::new(sys, config, reference).expect("controller");
+    let z0 = SVector::<f64, 4>::new(0.05, 0.05, 0.0, 0.0);
+    run(&mut ctrl, &sys, &z0, duration).expect("closed loop")
+}
+
+fn main() {
+    let mut duration = 30.0;
+    let args: Vec<String> = std::env::args().collect();
+    if let Some(i) = args.iter().position(|a| a == "--duration") {
+        duration = args
+            .get(i + 1)
+            .and_then(|v| v.parse().ok())
+            .filter(|d: &f64| *d > 0.0)
+            .unwrap_or_else(|| {
+                eprintln!("error: --duration needs a positive number of seconds");
+                std::process::exit(2)
+            });
+    }
+    println!(
+        "## EigenMPC control step, N = 80, dt = 25 ms, {duration} s closed loop (clarabel QP)\n"
+    );
+    println!("| scenario | phase | median ms | p95 ms | p99 ms | max ms | QP iter. median |");
+    println!("|---|---|---|---|---|---|---|");
+    for variant in [Variant::Curved, Variant::Straight] {
+        let trace = run_case(variant, 80, duration);
+        let rest = &trace[1..];
+        let prep: Vec<f64> = rest.iter().map(|s| s.preparation_time).collect();
+        let feedback: Vec<f64> = rest
+            .iter()
+            .map(|s| s.solve_time - s.preparation_time)
+            .collect();
+        let total: Vec<f64> = rest.iter().map(|s| s.solve_time).collect();
+        let mut iters: Vec<f64> = rest.iter().map(|s| s.qp_iterations as f64).collect();
+        iters.sort_by(f64::total_cmp);
+        let it = quantile(&iters, 0.5);
+        let name = format!("{variant} 14 J in-phase");
+        println!("| {name} | preparation | {} | |", ms(stats(prep)));
+        println!(
+            "| {name} | feedback (QP) | {} | {it:.0} |",
+            ms(stats(feedback))
+        );
+        println!("| {name} | total | {} | |", ms(stats(total)));
+        println!(
+            "| {name} | first sample (converged SQP, cold start) | {:.3} | | | | |",
+            trace[0].solve_time * 1e3
+        );
+    }
+    println!("\n## Growth with the horizon (curved 14 J, {duration} s closed loop)\n");
+    println!(
+        "| N | total median ms | p95 | p99 | max | preparation median ms | feedback median ms | median per interval us |"
+    );
+    println!("|---|---|---|---|---|---|---|---|");
+    for n in [20, 40, 80, 160, 320] {
+        let trace = run_case(Variant::Curved, n, duration);
+        let rest = &trace[1..];
+        let total = stats(rest.iter().map(|s| s.solve_time).collect());
+        let prep = stats(rest.iter().map(|s| s.preparation_time).collect());
+        let fb = stats(
+            rest.iter()
+                .map(|s| s.solve_time - s.preparation_time)
+                .collect(),
+        );
+        println!(
+            "| {n} | {} | {:.3} | {:.3} | {:.1} |",
+            ms(total),
+            prep[0] * 1e3,
+            fb[0] * 1e3,
+            total[0] * 1e6 / n as f64
+        );
+    }
+}

@@ -1,0 +1,206 @@
+//! Closed-loop simulation of the controller against the accurate plant
+//! (adaptive Dormand-Prince, torque held over each sample) and the summary
+//! figures of the paper's scenarios.
+
+use super::{ControlStatus, Controller};
+use crate::integrate::{Dopri5, IntegrationError, Tolerances};
+use crate::mechanics::{MechanicalSystem, Vector, state_derivative, state_energy};
+use nalgebra::SVector;
+
+/// One sample of a closed-loop run (state at the sample time, torque applied after it).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sample<const N: usize, const NX: usize> {
+    /// Time (s).
+    pub time: f64,
+    /// Measured state `z = (q, qd)`.
+    pub state: SVector<f64, NX>,
+    /// Torque applied over the following sample.
+    pub tau: Vector<N>,
+    /// Plant energy (J).
+    pub energy: f64,
+    /// Controller compute time, preparation + feedback (s).
+    pub solve_time: f64,
+    /// Preparation part of `solve_time` (s).
+    pub preparation_time: f64,
+    /// Controller status.
+    pub status: ControlStatus,
+    /// QP iterations in this sample.
+    pub qp_iterations: usize,
+}
+
+/// Runs `duration` seconds of closed loop from `z0`; the plant is `plant`
+/// (which may differ from the controller's model).
+pub fn run<S, P, const N: usize, const NX: usize>(
+    controller: &mut Controller<S, N, NX>,
+    plant: &P,
+    z0: &SVector<f64, NX>,
+    duration: f64,
+) -> Result<Vec<Sample<N, NX>>, IntegrationError>
+where
+    S: MechanicalSystem<N>,
+    P: MechanicalSystem<N>,
+{
+    let dt = controller.config().dt;
+    let steps = (duration / dt).round() as usize;
+    let mut trace = Vec::with_capacity(steps + 1);
+    let tol = Tolerances {
+        rtol: 1e-10,
+        atol: 1e-10,
+    };
+    let mut ode = Dopri5::new(0.0, *z0, tol);
+    for i in 0..=steps {
+        let t = i as f64 * dt;
+        let z = *ode.state();
+        let out = controller.step(&z);
+        trace.push(Sample {
+            time: t,
+            state: z,
+            tau: out.tau,
+            energy: state_energy::<P, N, NX>(plant, &z),
+            solve_time: out.preparation_time + out.feedback_time,
+            preparation_time: out.preparation_time,
+            status: out.status,
+            qp_iterations: out.qp_iterations,
+        });
+        if i == steps {
+            break;
+        }
+        let tau = out.tau;
+        ode.advance_to(
+            |_, z| state_derivative::<P, N, NX>(plant, z, &tau),
+            (i + 1) as f64 * dt,
+        )?;
+    }
+    Ok(trace)
+}
+
+/// Summary figures of a run (issue 3 / paper section V).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Summary<const N: usize> {
+    /// First time after which `|E - E_ref| < 5 % E_ref` holds for good (None: never).
+    pub time_to_5_percent: Option<f64>,
+    /// `E - E_ref` at the end (J).
+    pub final_energy_error: f64,
+    /// RMS torque per joint over the last `window` seconds (N m).
+    pub rms_torque: Vector<N>,
+    /// RMS distance of the last `window` seconds of the path to the mode path (rad), if given.
+    pub rms_distance: Option<f64>,
+    /// Per-sample compute time: median, p95, p99, max (s).
+    pub solve_time: [f64; 4],
+    /// Samples whose status was not OK.
+    pub failures: usize,
+}
+
+/// Quantile of sorted data (nearest rank).
+pub fn quantile(sorted: &[f64], p: f64) -> f64 {
+    if sorted.is_empty() {
+        return f64::NAN;
+    }
+    let idx = ((p * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len()) - 1;
+    sorted[idx]
+}
+
+/// Distance from `q` to the polyline `path`.
+pub fn distance_to_path<const N: usize>(q: &Vector<N>, path: &[Vector<N>]) -> f64 {
+    let mut best = f64::INFINITY;
+    for w in path.windows(2) {
+        let d = w[1] - w[0];
+        let len2 = d.norm_squared();
+        let t = if len2 > 0.0 {
+            ((q - w[0]).dot(&d) / len2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        best = best.min((q - (w[0] + d * t)).norm());
+    }
+    if path.len() == 1 {
+        best = (q - path[0]).norm();
+    }
+    best
+}
+
+/// Computes the [`Summary`] of a run over its last `window` seconds.
+pub fn summarise<const N: usize, const NX: usize>(
+    trace: &[Sample<N, NX>],
+    e_ref: f64,
+    mode_path: Option<&[Vector<N>]>,
+    window: f64,
+) -> Summary<N> {
+    let band = 0.05 * e_ref.abs();
+    let last_outside = trace
+        .iter()
+        .rposition(|s| (s.energy - e_ref).abs() >= band || !s.energy.is_finite());
+    let time_to_5_percent = match last_outside {
+        None => trace.first().map(|s| s.time),
+        Some(i) if i + 1 < trace.len() => Some(trace[i + 1].time),
+        Some(_) => None,
+    };
+    let t_end = trace.last().map_or(0.0, |s| s.time);
+    let tail: Vec<&Sample<N, NX>> = trace
+        .iter()
+        .filter(|s| s.time > t_end - window + 1e-9)
+        .collect();
+    let n = tail.len().max(1) as f64;
+    let mut rms_torque = Vector::<N>::zeros();
+    for s in &tail {
+        rms_torque += s.tau.component_mul(&s.tau);
+    }
+    let rms_torque = (rms_torque / n).map(f64::sqrt);
+    let rms_distance = mode_path.map(|path| {
+        let sum: f64 = tail
+            .iter()
+            .map(|s| {
+                let q = s.state.fixed_rows::<N>(0).into_owned();
+                distance_to_path(&q, path).powi(2)
+            })
+            .sum();
+        (sum / n).sqrt()
+    });
+    let mut times: Vec<f64> = trace.iter().map(|s| s.solve_time).collect();
+    times.sort_by(f64::total_cmp);
+    Summary {
+        time_to_5_percent,
+        final_energy_error: trace.last().map_or(f64::NAN, |s| s.energy - e_ref),
+        rms_torque,
+        rms_distance,
+        solve_time: [
+            quantile(&times, 0.5),
+            quantile(&times, 0.95),
+            quantile(&times, 0.99),
+            times.last().copied().unwrap_or(f64::NAN),
+        ],
+        failures: trace.iter().filter(|s| !s.status.is_ok()).count(),
+    }
+}
+
+/// The true eigenmode of family `mode_index` at `energy` and its chart of
+/// the given degree (the paper uses 9): what the curved cost and the
+/// distance metric need.
+pub fn mode_and_chart<S, const N: usize, const NX: usize>(
+    system: &S,
+    mode_index: usize,
+    energy: f64,
+    degree: usize,
+) -> Result<(crate::modes::Eigenmode<N>, crate::modes::Chart<N>), crate::modes::ModeError>
+where
+    S: MechanicalSystem<N>,
+{
+    use crate::modes::{Chart, ContinuationOptions, eigenmode_family, linear_modes};
+    let linear = linear_modes(system)?;
+    let eigenvector = linear
+        .get(mode_index)
+        .ok_or(crate::modes::ModeError::NoSuchMode {
+            index: mode_index,
+            dof: N,
+        })?
+        .eigenvector;
+    let mode = eigenmode_family::<S, N, NX>(
+        system,
+        mode_index,
+        &[energy],
+        &ContinuationOptions::default(),
+    )?
+    .remove(0);
+    let chart = Chart::fit(&mode.path, &eigenvector, &system.equilibrium(), degree)?;
+    Ok((mode, chart))
+}

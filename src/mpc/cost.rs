@@ -1,0 +1,302 @@
+//! The EigenMPC running costs (paper, eqs. 10 and 12) in least-squares form
+//! `l = w_E r_E^2 + w_x |r_x|^2 + w_xd |r_xd|^2 + w_F |r_F|^2`, their exact
+//! residual Jacobians and the Gauss-Newton Hessian blocks they give.
+
+use crate::mechanics::{Matrix, MechanicalSystem, Vector, unpack_state};
+use crate::modes::Chart;
+use nalgebra::{SMatrix, SVector};
+
+/// The paper's weights `W_z = diag(w_E, w_x, w_x, w_xd, w_xd)`, `W_F = w_F I`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Weights {
+    /// Energy error weight `w_E`.
+    pub energy: f64,
+    /// Position-distance weight `w_x`.
+    pub position: f64,
+    /// Velocity-distance weight `w_xd`.
+    pub velocity: f64,
+    /// Torque weight `w_F`.
+    pub torque: f64,
+}
+
+impl Weights {
+    /// The paper's tuning (section V-A): `w_x = 50`, `w_xd = 2500`,
+    /// `w_F = 225`, `w_E = 25` (curved) or `5` (straight).
+    pub fn paper(variant: Variant) -> Self {
+        Self {
+            energy: match variant {
+                Variant::Curved => 25.0,
+                Variant::Straight => 5.0,
+            },
+            position: 50.0,
+            velocity: 2500.0,
+            torque: 225.0,
+        }
+    }
+}
+
+/// Which EigenMPC cost.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Variant {
+    /// Distance to the linear eigenvector line, blended by `tanh(alpha E)`.
+    Straight,
+    /// Distance to a precomputed eigenmode chart `X(s)`.
+    Curved,
+}
+
+impl std::str::FromStr for Variant {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "straight" => Ok(Variant::Straight),
+            "curved" => Ok(Variant::Curved),
+            other => Err(format!(
+                "unknown variant '{other}' (expected straight or curved)"
+            )),
+        }
+    }
+}
+
+impl std::fmt::Display for Variant {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Variant::Straight => "straight",
+            Variant::Curved => "curved",
+        })
+    }
+}
+
+/// The a-priori knowledge the cost measures distances to.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Reference<const N: usize> {
+    /// Straight EigenMPC: the unit linear eigenvector `c`.
+    Straight {
+        /// Unit eigenvector of the linearised system.
+        eigenvector: Vector<N>,
+    },
+    /// Curved EigenMPC: a chart of the eigenmode at `E_ref`.
+    Curved(Chart<N>),
+}
+
+impl<const N: usize> Reference<N> {
+    /// The cost variant this reference selects.
+    pub fn variant(&self) -> Variant {
+        match self {
+            Reference::Straight { .. } => Variant::Straight,
+            Reference::Curved(_) => Variant::Curved,
+        }
+    }
+
+    /// Checks for non-finite or degenerate data.
+    pub fn validate(&self) -> Result<(), String> {
+        let c = match self {
+            Reference::Straight { eigenvector } => eigenvector,
+            Reference::Curved(chart) => {
+                if chart.coefficients.iter().flatten().any(|v| !v.is_finite())
+                    || chart.equilibrium.iter().any(|v| !v.is_finite())
+                {
+                    return Err("chart coefficients must be finite".into());
+                }
+                &chart.eigenvector
+            }
+        };
+        if c.iter().any(|v| !v.is_finite()) || c.norm() < 1e-12 {
+            return Err("the eigenvector must be finite and nonzero".into());
+        }
+        Ok(())
+    }
+}
+
+/// Tunable cost parameters (may change between samples).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CostParams {
+    /// Reference energy `E_ref` (J).
+    pub e_ref: f64,
+    /// Exploration gain `alpha` of the straight cost (1/J).
+    pub alpha: f64,
+    /// Torque-weight offset `beta` of the straight cost.
+    pub beta: f64,
+    /// Residual weights.
+    pub weights: Weights,
+}
+
+/// Residuals of one stage and their Jacobians w.r.t. `z = (q, qd)` and `tau`.
+#[derive(Clone, Copy, Debug)]
+pub struct Residuals<const N: usize, const NX: usize> {
+    /// `E_ref - E`.
+    pub energy: f64,
+    /// `d(E_ref - E)/dz`.
+    pub energy_z: SVector<f64, NX>,
+    /// Position distance `r_x`.
+    pub position: Vector<N>,
+    /// `d r_x / dz`.
+    pub position_z: SMatrix<f64, N, NX>,
+    /// Velocity distance `r_xd`.
+    pub velocity: Vector<N>,
+    /// `d r_xd / dz`.
+    pub velocity_z: SMatrix<f64, N, NX>,
+    /// Torque residual `r_F`.
+    pub torque: Vector<N>,
+    /// `d r_F / dz`.
+    pub torque_z: SMatrix<f64, N, NX>,
+    /// `d r_F / dtau`.
+    pub torque_u: Matrix<N>,
+}
+
+/// Evaluates the residuals of the chosen cost, literally as in the paper.
+pub fn residuals<S, const N: usize, const NX: usize>(
+    system: &S,
+    reference: &Reference<N>,
+    params: &CostParams,
+    z: &SVector<f64, NX>,
+    tau: &Vector<N>,
+) -> Residuals<N, NX>
+where
+    S: MechanicalSystem<N> + ?Sized,
+{
+    let (q, qd) = unpack_state::<N, NX>(z);
+    let energy = system.energy(&q, &qd);
+    let (de_dq, de_dqd) = system.energy_gradient(&q, &qd);
+    let mut grad_e = SVector::<f64, NX>::zeros();
+    grad_e.fixed_rows_mut::<N>(0).copy_from(&de_dq);
+    grad_e.fixed_rows_mut::<N>(N).copy_from(&de_dqd);
+    let eye = Matrix::<N>::identity();
+    let mut r = Residuals {
+        energy: params.e_ref - energy,
+        energy_z: -grad_e,
+        position: Vector::<N>::zeros(),
+        position_z: SMatrix::zeros(),
+        velocity: Vector::<N>::zeros(),
+        velocity_z: SMatrix::zeros(),
+        torque: *tau,
+        torque_z: SMatrix::zeros(),
+        torque_u: eye,
+    };
+    match reference {
+        Reference::Straight { eigenvector } => {
+            let c = eigenvector;
+            let perp = eye - c * c.transpose();
+            let t = (params.alpha * energy).tanh();
+            let dt_dz = grad_e * (params.alpha * (1.0 - t * t));
+            let g = 1.0 - t;
+            let dq = q - system.equilibrium();
+            let pdq = perp * dq;
+            let pqd = perp * qd;
+            r.position = pdq * g;
+            r.position_z
+                .fixed_view_mut::<N, N>(0, 0)
+                .copy_from(&(perp * g));
+            r.position_z -= pdq * dt_dz.transpose();
+            r.velocity = pqd * g;
+            r.velocity_z
+                .fixed_view_mut::<N, N>(0, N)
+                .copy_from(&(perp * g));
+            r.velocity_z -= pqd * dt_dz.transpose();
+            r.torque = tau * (t + params.beta);
+            r.torque_z = tau * dt_dz.transpose();
+            r.torque_u = eye * (t + params.beta);
+        }
+        Reference::Curved(chart) => {
+            let c0 = chart.eigenvector;
+            let s = chart.coordinate(&q);
+            let sd = c0.dot(&qd);
+            let p = chart.eval(s);
+            let norm = p.dx.norm().max(1e-12);
+            let c = p.dx / norm;
+            let dc = (p.ddx - c * c.dot(&p.ddx)) / norm;
+            let perp = eye - c * c.transpose();
+            let dperp = -(dc * c.transpose() + c * dc.transpose());
+            let along = eye - p.dx * c0.transpose();
+            let ex = q - p.x;
+            let ev = qd - p.dx * sd;
+            r.position = perp * ex;
+            r.position_z
+                .fixed_view_mut::<N, N>(0, 0)
+                .copy_from(&(perp * along + dperp * ex * c0.transpose()));
+            r.velocity = perp * ev;
+            r.velocity_z.fixed_view_mut::<N, N>(0, 0).copy_from(
+                &(-(perp * p.ddx) * (sd * c0.transpose()) + dperp * ev * c0.transpose()),
+            );
+            r.velocity_z
+                .fixed_view_mut::<N, N>(0, N)
+                .copy_from(&(perp * along));
+        }
+    }
+    r
+}
+
+/// Gauss-Newton model of `scale * l(z, tau)`: value, gradient and Hessian
+/// blocks (`2 scale J' W J`, positive semidefinite by construction).
+#[derive(Clone, Copy, Debug)]
+pub struct StageModel<const N: usize, const NX: usize> {
+    /// `scale * l`.
+    pub cost: f64,
+    /// Hessian block `d2/dz2`.
+    pub q: SMatrix<f64, NX, NX>,
+    /// Hessian block `d2/(dtau dz)`.
+    pub s: SMatrix<f64, N, NX>,
+    /// Hessian block `d2/dtau2`.
+    pub r: Matrix<N>,
+    /// Gradient w.r.t. `z`.
+    pub gz: SVector<f64, NX>,
+    /// Gradient w.r.t. `tau`.
+    pub gu: Vector<N>,
+}
+
+/// Value, gradient and Gauss-Newton Hessian of `scale * l(z, tau)`.
+pub fn stage_model<S, const N: usize, const NX: usize>(
+    system: &S,
+    reference: &Reference<N>,
+    params: &CostParams,
+    z: &SVector<f64, NX>,
+    tau: &Vector<N>,
+    scale: f64,
+) -> StageModel<N, NX>
+where
+    S: MechanicalSystem<N> + ?Sized,
+{
+    let r = residuals::<S, N, NX>(system, reference, params, z, tau);
+    let w = &params.weights;
+    let two = 2.0 * scale;
+    let q = (r.energy_z * r.energy_z.transpose()) * w.energy
+        + r.position_z.transpose() * r.position_z * w.position
+        + r.velocity_z.transpose() * r.velocity_z * w.velocity
+        + r.torque_z.transpose() * r.torque_z * w.torque;
+    let gz = r.energy_z * (r.energy * w.energy)
+        + r.position_z.transpose() * r.position * w.position
+        + r.velocity_z.transpose() * r.velocity * w.velocity
+        + r.torque_z.transpose() * r.torque * w.torque;
+    StageModel {
+        cost: scale
+            * (w.energy * r.energy * r.energy
+                + w.position * r.position.norm_squared()
+                + w.velocity * r.velocity.norm_squared()
+                + w.torque * r.torque.norm_squared()),
+        q: q * two,
+        s: r.torque_u.transpose() * r.torque_z * (two * w.torque),
+        r: r.torque_u.transpose() * r.torque_u * (two * w.torque),
+        gz: gz * two,
+        gu: r.torque_u.transpose() * r.torque * (two * w.torque),
+    }
+}
+
+/// `scale * l(z, tau)` only (line search, reporting).
+pub fn stage_cost<S, const N: usize, const NX: usize>(
+    system: &S,
+    reference: &Reference<N>,
+    params: &CostParams,
+    z: &SVector<f64, NX>,
+    tau: &Vector<N>,
+    scale: f64,
+) -> f64
+where
+    S: MechanicalSystem<N> + ?Sized,
+{
+    let r = residuals::<S, N, NX>(system, reference, params, z, tau);
+    let w = &params.weights;
+    scale
+        * (w.energy * r.energy * r.energy
+            + w.position * r.position.norm_squared()
+            + w.velocity * r.velocity.norm_squared()
+            + w.torque * r.torque.norm_squared())
+}

@@ -1,0 +1,179 @@
+//! `eigenmpc modes` end to end: JSON shape and values, and one-line errors.
+
+use serde_json::Value;
+use std::process::Command;
+
+fn run(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_eigenmpc"))
+        .args(args)
+        .output()
+        .expect("run eigenmpc");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn modes_prints_the_documented_json() {
+    let (code, stdout, stderr) = run(&["modes", "--family", "in-phase", "--energies", "2,8,14"]);
+    assert_eq!(code, 0, "{stderr}");
+    let doc: Value = serde_json::from_str(&stdout).expect("valid JSON");
+    assert_eq!(doc["model"]["kind"], "double-pendulum");
+    for key in ["m1", "m2", "l1", "l2"] {
+        assert_eq!(doc["model"][key], 1.0);
+    }
+    assert_eq!(doc["model"]["g"], 9.81);
+    assert_eq!(doc["family"], "in-phase");
+    let omega = doc["linear"]["omega"].as_f64().unwrap();
+    assert!((omega - (9.81f64 * (2.0 - 2f64.sqrt())).sqrt()).abs() < 1e-12);
+    let c = &doc["linear"]["eigenvector"];
+    assert!((c[0].as_f64().unwrap() - 0.9239).abs() < 1e-4);
+    assert!((c[1].as_f64().unwrap() - 0.3827).abs() < 1e-4);
+    let modes = doc["modes"].as_array().unwrap();
+    assert_eq!(modes.len(), 3);
+    let m = &modes[2];
+    assert_eq!(m["energy"], 14.0);
+    assert!((m["half_period"].as_f64().unwrap() - 1.3877).abs() < 1e-4);
+    assert!(m["closing_error"].as_f64().unwrap() < 1e-9);
+    let tp: Vec<f64> = serde_json::from_value(m["turning_point"].clone()).unwrap();
+    let other: Vec<f64> = serde_json::from_value(m["other_turning_point"].clone()).unwrap();
+    assert!(
+        0.9239 * tp[0] + 0.3827 * tp[1] > 0.0,
+        "turning_point has c'q > 0"
+    );
+    assert!((tp[0] + other[0]).abs() < 1e-8 && (tp[1] + other[1]).abs() < 1e-8);
+    let path = m["path"].as_array().unwrap();
+    assert_eq!(path.len(), 200);
+    assert_eq!(path[0][0].as_f64().unwrap(), tp[0]);
+    let chart = &m["chart"];
+    assert_eq!(chart["degree"], 9);
+    let coef: Vec<Vec<f64>> = serde_json::from_value(chart["coefficients"].clone()).unwrap();
+    assert_eq!(coef.len(), 2);
+    assert!(coef.iter().all(|c| c.len() == 10));
+    let residual = chart["max_residual"].as_f64().unwrap();
+    assert!(residual > 0.0 && residual < 2e-3, "{residual}");
+    // The polynomial really passes near the turning point.
+    let s = 0.923879532511287 * tp[0] + 0.38268343236508934 * tp[1];
+    let x: Vec<f64> = coef
+        .iter()
+        .map(|c| c.iter().rev().fold(0.0, |acc, a| acc * s + a))
+        .collect();
+    assert!((x[0] - tp[0]).abs() < 3e-3 && (x[1] - tp[1]).abs() < 3e-3);
+}
+
+#[test]
+fn modes_options_change_the_output() {
+    let (code, stdout, stderr) = run(&[
+        "modes",
+        "--family",
+        "anti-phase",
+        "--energies",
+        "2",
+        "--degree",
+        "5",
+        "--samples",
+        "50",
+        "--m2",
+        "0.5",
+        "--l1",
+        "1.2",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let doc: Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(doc["family"], "anti-phase");
+    assert_eq!(doc["model"]["m2"], 0.5);
+    assert_eq!(doc["modes"][0]["path"].as_array().unwrap().len(), 50);
+    assert_eq!(
+        doc["modes"][0]["chart"]["coefficients"][0]
+            .as_array()
+            .unwrap()
+            .len(),
+        6
+    );
+    let c1 = doc["linear"]["eigenvector"][1].as_f64().unwrap();
+    assert!(c1 < 0.0, "anti-phase eigenvector has opposite signs");
+}
+
+#[test]
+fn bad_input_gives_one_line_errors_and_nonzero_exit() {
+    for (args, needle) in [
+        (
+            vec!["modes", "--family", "sideways", "--energies", "2"],
+            "unknown family",
+        ),
+        (
+            vec!["modes", "--energies", "2,-1"],
+            "energy -1 J is invalid",
+        ),
+        (vec!["modes", "--energies", "0"], "energy 0 J is invalid"),
+        (vec!["modes", "--energies", "2", "--m1", "-1"], "m1"),
+        (vec!["modes", "--energies", "abc"], "not a number"),
+        (
+            vec!["modes", "--energies", "70"],
+            "cannot be continued beyond",
+        ),
+        (
+            vec!["modes", "--energies", "2", "--samples", "5"],
+            "too few",
+        ),
+    ] {
+        let (code, stdout, stderr) = run(&args);
+        assert_ne!(code, 0, "{args:?} should fail");
+        assert!(stdout.is_empty(), "{args:?} printed {stdout}");
+        assert!(stderr.contains(needle), "{args:?}: {stderr}");
+        assert_eq!(stderr.trim_end().lines().count(), 1, "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+    }
+}
+
+#[test]
+fn fmu_start_values_carry_the_chart_of_the_requested_mode() {
+    let dir = std::env::temp_dir().join(format!("eigenmpc-sv-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("start.json");
+    let file_arg = file.to_str().unwrap();
+    let (code, stdout, stderr) =
+        run(&["modes", "--energies", "14", "--fmu-start-values", file_arg]);
+    assert_eq!(code, 0, "{stderr}");
+    let doc: Value = serde_json::from_str(&stdout).unwrap();
+    let values: Value = serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
+    assert_eq!(values["E_ref"], 14.0);
+    assert_eq!(values["m[1]"], 1.0);
+    assert_eq!(values["g"], 9.81);
+    assert_eq!(values["c[1]"], doc["linear"]["eigenvector"][0]);
+    assert_eq!(values["c[2]"], doc["linear"]["eigenvector"][1]);
+    for j in 0..2 {
+        for k in 0..10 {
+            assert_eq!(
+                values[format!("chart.coef[{},{k}]", j + 1)],
+                doc["modes"][0]["chart"]["coefficients"][j][k]
+            );
+        }
+    }
+    assert_eq!(values.as_object().unwrap().len(), 1 + 5 + 2 + 20);
+    // Lower degree pads with zeros; several energies are refused.
+    let (code, _, _) = run(&[
+        "modes",
+        "--energies",
+        "14",
+        "--degree",
+        "5",
+        "--fmu-start-values",
+        file_arg,
+    ]);
+    assert_eq!(code, 0);
+    let values: Value = serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
+    assert_eq!(values["chart.coef[2,9]"], 0.0);
+    let (code, _, stderr) = run(&[
+        "modes",
+        "--energies",
+        "2,14",
+        "--fmu-start-values",
+        file_arg,
+    ]);
+    assert_ne!(code, 0);
+    assert!(stderr.contains("exactly one energy"), "{stderr}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -1,0 +1,111 @@
+//! The per-sample control step allocates nothing of its own (counting
+//! global allocator). clarabel's `solve` itself allocates once per call (its
+//! timer map is rebuilt by `Info::reset`); that is measured separately and
+//! bounded, so a regression on either side fails.
+
+use eigenmpc::mechanics::DoublePendulum;
+use eigenmpc::modes::linear_modes;
+use eigenmpc::mpc::closed_loop::mode_and_chart;
+use eigenmpc::mpc::{Controller, MpcConfig, Reference};
+use eigenmpc::qp::clarabel::{ClarabelQpSolver, rti_settings};
+use eigenmpc::qp::{OcpQp, QpSolution, QpSolver, QpStatus};
+use nalgebra::SVector;
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+struct Counting;
+/// Allocations outside the QP backend.
+static OURS: AtomicUsize = AtomicUsize::new(0);
+/// Allocations inside the QP backend's `solve`.
+static BACKEND: AtomicUsize = AtomicUsize::new(0);
+static IN_BACKEND: AtomicUsize = AtomicUsize::new(0);
+
+fn count() {
+    if IN_BACKEND.load(Ordering::SeqCst) > 0 {
+        BACKEND.fetch_add(1, Ordering::SeqCst);
+    } else {
+        OURS.fetch_add(1, Ordering::SeqCst);
+    }
+}
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        count();
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        count();
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+/// clarabel, with its allocations attributed to the backend.
+struct Attributed(ClarabelQpSolver);
+impl QpSolver for Attributed {
+    fn name(&self) -> &'static str {
+        self.0.name()
+    }
+    fn solve(&mut self, qp: &OcpQp, solution: &mut QpSolution) -> QpStatus {
+        IN_BACKEND.fetch_add(1, Ordering::SeqCst);
+        let status = self.0.solve(qp, solution);
+        IN_BACKEND.fetch_sub(1, Ordering::SeqCst);
+        status
+    }
+}
+
+#[test]
+fn control_steps_do_not_allocate() {
+    let sys = DoublePendulum::default();
+    let (_, chart) = mode_and_chart::<_, 2, 4>(&sys, 0, 14.0, 9).unwrap();
+    let references = [
+        Reference::Straight {
+            eigenvector: linear_modes(&sys).unwrap()[0].eigenvector,
+        },
+        Reference::Curved(chart),
+    ];
+    for reference in references {
+        let variant = reference.variant();
+        let mut config = MpcConfig::paper(variant);
+        config.horizon = 40;
+        let solver = Attributed(ClarabelQpSolver::new(4, 2, 40, rti_settings()));
+        let mut ctrl =
+            Controller::<_, 2, 4>::with_solver(sys, config, reference, Box::new(solver)).unwrap();
+        let mut z = SVector::<f64, 4>::new(0.3, 0.2, 0.0, 0.0);
+        // First samples: set-up of the QP solver (pattern, symbolic factorisation).
+        for _ in 0..3 {
+            let tau = ctrl.step(&z).tau;
+            z = eigenmpc::integrate::rk4_step::<_, 2, 4>(&sys, &z, &tau, 0.025);
+        }
+        let ours = OURS.load(Ordering::SeqCst);
+        let backend = BACKEND.load(Ordering::SeqCst);
+        let samples = 50;
+        for _ in 0..samples {
+            ctrl.prepare();
+            let out = ctrl.feedback(&z);
+            assert!(out.status.is_ok());
+            z = eigenmpc::integrate::rk4_step::<_, 2, 4>(&sys, &z, &out.tau, 0.025);
+        }
+        // Tuning between samples does not allocate either.
+        ctrl.set_e_ref(12.0).unwrap();
+        ctrl.set_alpha(0.2).unwrap();
+        ctrl.step(&z);
+        let ours = OURS.load(Ordering::SeqCst) - ours;
+        let backend = BACKEND.load(Ordering::SeqCst) - backend;
+        assert_eq!(ours, 0, "{variant}: controller allocated {ours} times");
+        assert!(
+            backend <= samples + 1,
+            "{variant}: clarabel allocated {backend} times in {} solves",
+            samples + 1
+        );
+        eprintln!(
+            "{variant}: clarabel allocations per solve: {}",
+            backend as f64 / (samples + 1) as f64
+        );
+    }
+}

@@ -1,0 +1,111 @@
+//! `eigenmpc simulate`: summary, CSV columns, plots, clear errors.
+
+use std::process::Command;
+
+fn eigenmpc(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_eigenmpc"))
+        .args(args)
+        .output()
+        .expect("run eigenmpc")
+}
+
+#[test]
+fn simulate_writes_csv_and_plots() {
+    let dir = std::env::temp_dir().join(format!("eigenmpc-sim-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("out.csv");
+    let png = dir.join("out.png");
+    let out = eigenmpc(&[
+        "simulate",
+        "--variant",
+        "straight",
+        "--family",
+        "anti-phase",
+        "--energy",
+        "2",
+        "--x0",
+        "0.05,-0.05,0,0",
+        "--duration",
+        "2",
+        "--N",
+        "20",
+        "--csv",
+        csv.to_str().unwrap(),
+        "--plot",
+        png.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("solve time per sample"), "{stdout}");
+    assert!(stdout.contains("RMS distance to the mode"), "{stdout}");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next(),
+        Some("time,q1,q2,qd1,qd2,tau1,tau2,energy,solve_ms")
+    );
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 81, "2 s at 25 ms plus the initial sample");
+    assert!((rows[0][1] - 0.05).abs() < 1e-15 && (rows[0][2] + 0.05).abs() < 1e-15);
+    assert!(
+        rows.iter()
+            .all(|r| r[5].abs() <= 1.0 + 1e-12 && r[6].abs() <= 1.0 + 1e-12)
+    );
+    // The energy column is the plant energy: it must grow under the controller.
+    assert!(rows[80][7] > rows[0][7]);
+    let bytes = std::fs::read(&png).unwrap();
+    assert_eq!(&bytes[1..4], b"PNG");
+    let svg = dir.join("out.svg");
+    let out = eigenmpc(&[
+        "simulate",
+        "--energy",
+        "3",
+        "--duration",
+        "0.5",
+        "--N",
+        "10",
+        "--plot",
+        svg.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(std::fs::read_to_string(&svg).unwrap().contains("<svg"));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn simulate_refuses_bad_input_with_a_message() {
+    for (args, needle) in [
+        (vec!["simulate", "--variant", "wobbly"], "unknown variant"),
+        (vec!["simulate", "--x0", "1,2"], "--x0"),
+        (vec!["simulate", "--dt", "-1", "--duration", "1"], "dt"),
+        (vec!["simulate", "--energy", "nan"], "--energy"),
+        (
+            vec![
+                "simulate",
+                "--variant",
+                "curved",
+                "--chart",
+                "/nonexistent.json",
+                "--duration",
+                "1",
+            ],
+            "nonexistent",
+        ),
+    ] {
+        let out = eigenmpc(&args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?}");
+        assert!(stderr.contains(needle), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    }
+}

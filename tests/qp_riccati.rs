@@ -1,0 +1,412 @@
+//! The Riccati interior-point QP solver against independent references
+//! (dense KKT solves and clarabel on the same QP assembled as one sparse
+//! problem), checked with the solver-independent KKT residuals.
+
+mod common;
+
+use common::qp_reference::{Reference, clarabel_solve, dense_kkt_solve};
+use eigenmpc::qp::record::{QpRecordReader, QpRecordWriter};
+use eigenmpc::qp::synthetic::{PendulumQpOptions, SplitMix64, pendulum_rti_qp, random_ocp_qp};
+use eigenmpc::qp::{
+    OcpQp, QpSolution, QpSolver, QpStatus, RiccatiSettings, RiccatiSolver, kkt_residuals,
+};
+use std::path::{Path, PathBuf};
+
+/// Acceptance tolerances of issue 5.
+const U0_TOL: f64 = 1e-6;
+const OBJ_REL_TOL: f64 = 1e-8;
+const KKT_TOL: f64 = 1e-8;
+/// Relative stationarity accepted when the costate is so large (|pi| ~ 1e7
+/// on unstable linearisations) that round-off of the sums alone exceeds
+/// `KKT_TOL`: 1e-12 is still ~4500 ulps.
+const KKT_REL_TOL: f64 = 1e-12;
+
+fn solve(qp: &OcpQp) -> (QpSolution, RiccatiSolver) {
+    let mut solver = RiccatiSolver::new(qp.nx, qp.nu, qp.horizon, RiccatiSettings::default());
+    let mut sol = QpSolution::new(qp.nx, qp.nu, qp.horizon);
+    let status = solver.solve(qp, &mut sol);
+    assert_eq!(status, sol.status);
+    (sol, solver)
+}
+
+/// Asserts the issue-5 acceptance criteria of `sol` against `reference`.
+fn assert_matches(what: &str, qp: &OcpQp, sol: &QpSolution, reference: &Reference) {
+    assert_eq!(sol.status, QpStatus::Solved, "{what}: status");
+    assert!(reference.solved, "{what}: reference failed");
+    let du0 = (&sol.u[0] - &reference.u[0]).amax();
+    assert!(du0 <= U0_TOL, "{what}: first control differs by {du0:e}");
+    let rel = (sol.objective - reference.objective).abs() / reference.objective.abs().max(1.0);
+    assert!(
+        rel <= OBJ_REL_TOL,
+        "{what}: objective {} vs {} (rel {rel:e})",
+        sol.objective,
+        reference.objective
+    );
+    let kkt = kkt_residuals(qp, sol);
+    assert!(
+        kkt.within(KKT_TOL, KKT_REL_TOL),
+        "{what}: KKT residuals {kkt:?}"
+    );
+    let obj_rel = (kkt.objective - sol.objective).abs() / sol.objective.abs().max(1.0);
+    assert!(
+        obj_rel <= 1e-9,
+        "{what}: reported objective {obj_rel:e} off"
+    );
+}
+
+fn with_control_box(mut qp: OcpQp, bound: f64) -> OcpQp {
+    for k in 0..qp.horizon {
+        qp.u_lower[k].fill(-bound);
+        qp.u_upper[k].fill(bound);
+    }
+    qp
+}
+
+#[test]
+fn unconstrained_matches_dense_kkt() {
+    let mut rng = SplitMix64::new(1);
+    for &n in &[1, 5, 80] {
+        for rep in 0..3 {
+            let qp = random_ocp_qp(&mut rng, 4, 2, n);
+            let (sol, solver) = solve(&qp);
+            let (reference, pi) = dense_kkt_solve(&qp);
+            let what = format!("N = {n}, rep {rep}");
+            assert_matches(&what, &qp, &sol, &reference);
+            // No inequalities: one Newton step is exact.
+            assert_eq!(solver.info().iterations, 1, "{what}");
+            for (k, pi_k) in pi.iter().enumerate() {
+                let dx = (&sol.x[k + 1] - &reference.x[k + 1]).amax();
+                let dpi = (&sol.pi[k] - pi_k).amax();
+                assert!(
+                    dx <= 1e-9 && dpi <= 1e-8,
+                    "{what}: stage {k}: {dx:e} {dpi:e}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn other_dimensions_match_dense_kkt() {
+    // Runtime-dimension kernels (nx = 3, nu = 1; nx = 5, nu = 4) and the
+    // specialised single- and triple-joint sizes.
+    let mut rng = SplitMix64::new(2);
+    for &(nx, nu) in &[(3, 1), (5, 4), (2, 1), (6, 3)] {
+        let qp = random_ocp_qp(&mut rng, nx, nu, 12);
+        let (sol, _) = solve(&qp);
+        let (reference, _) = dense_kkt_solve(&qp);
+        assert_matches(&format!("nx = {nx}, nu = {nu}"), &qp, &sol, &reference);
+        let qp = with_control_box(qp, 0.3);
+        let (sol, _) = solve(&qp);
+        assert_matches(
+            &format!("boxed nx = {nx}, nu = {nu}"),
+            &qp,
+            &sol,
+            &clarabel_solve(&qp),
+        );
+    }
+}
+
+#[test]
+fn bounded_random_qps_match_clarabel() {
+    let mut rng = SplitMix64::new(3);
+    for &n in &[1, 5, 80] {
+        for &bound in &[10.0, 0.5, 0.2] {
+            let qp = with_control_box(random_ocp_qp(&mut rng, 4, 2, n), bound);
+            let (sol, solver) = solve(&qp);
+            let what = format!("N = {n}, |u| <= {bound}");
+            assert_matches(&what, &qp, &sol, &clarabel_solve(&qp));
+            assert_eq!(solver.info().regularised_pivots, 0, "{what}");
+        }
+    }
+}
+
+#[test]
+fn one_sided_bounds_match_clarabel() {
+    let mut rng = SplitMix64::new(4);
+    let mut qp = random_ocp_qp(&mut rng, 4, 2, 20);
+    for k in 0..20 {
+        qp.u_lower[k][0] = -0.1;
+        qp.u_upper[k][1] = 0.05;
+    }
+    let (sol, _) = solve(&qp);
+    assert_matches("one-sided", &qp, &sol, &clarabel_solve(&qp));
+}
+
+#[test]
+fn many_active_bounds() {
+    let mut rng = SplitMix64::new(5);
+    let opts = PendulumQpOptions {
+        tau_max: 0.2,
+        ..Default::default()
+    };
+    let mut active_total = 0;
+    for rep in 0..5 {
+        let qp = pendulum_rti_qp(&mut rng, &opts);
+        let (sol, _) = solve(&qp);
+        assert_matches(
+            &format!("tau_max 0.2, rep {rep}"),
+            &qp,
+            &sol,
+            &clarabel_solve(&qp),
+        );
+        active_total += (0..qp.horizon)
+            .flat_map(|k| (0..2).map(move |j| (k, j)))
+            .filter(|&(k, j)| {
+                let u = sol.u[k][j];
+                (u - qp.u_lower[k][j]).min(qp.u_upper[k][j] - u) < 1e-8
+            })
+            .count();
+    }
+    // The point of the case: a large share of the 5 x 160 bounds is active.
+    assert!(active_total > 200, "only {active_total} active bounds");
+}
+
+#[test]
+fn degenerate_bounds_fix_controls() {
+    let mut rng = SplitMix64::new(6);
+    let mut qp = with_control_box(random_ocp_qp(&mut rng, 4, 2, 30), 0.5);
+    for k in (0..30).step_by(3) {
+        qp.u_lower[k][1] = 0.25;
+        qp.u_upper[k][1] = 0.25;
+    }
+    // A fully fixed stage too.
+    qp.u_lower[7].fill(-0.1);
+    qp.u_upper[7].fill(-0.1);
+    let (sol, _) = solve(&qp);
+    assert_matches("degenerate bounds", &qp, &sol, &clarabel_solve(&qp));
+    for k in (0..30).step_by(3) {
+        assert!((sol.u[k][1] - 0.25).abs() <= 1e-9);
+    }
+    assert!((sol.u[7][0] + 0.1).abs() <= 1e-9);
+}
+
+#[test]
+fn soft_state_bounds_absorb_unrecoverable_initial_state() {
+    let mut rng = SplitMix64::new(7);
+    for &(l1, l2) in &[(10.0, 100.0), (50.0, 0.0), (0.0, 20.0)] {
+        let mut qp = with_control_box(random_ocp_qp(&mut rng, 4, 2, 40), 0.3);
+        for k in 0..=40 {
+            qp.x_lower[k].fill(-0.2);
+            qp.x_upper[k].fill(0.2);
+        }
+        // Component 3 only bounded above, component 0 only below.
+        for k in 0..=40 {
+            qp.x_lower[k][3] = f64::NEG_INFINITY;
+            qp.x_upper[k][0] = f64::INFINITY;
+        }
+        qp.soft_l1.fill(l1);
+        qp.soft_l2.fill(l2);
+        qp.x0 = nalgebra::DVector::from_vec(vec![5.0, -4.0, 3.0, 6.0]);
+        let (sol, _) = solve(&qp);
+        let what = format!("soft l1 = {l1}, l2 = {l2}");
+        assert_matches(&what, &qp, &sol, &clarabel_solve(&qp));
+        // The bounds are violated (the controls cannot recover x0 at once),
+        // yet the QP is solved.
+        let violated = (1..=40)
+            .filter(|&k| sol.x[k][2] > 0.2 + 1e-6 || sol.x[k][3] > 0.2 + 1e-6)
+            .count();
+        assert!(violated > 0, "{what}: no violated soft bound");
+    }
+}
+
+#[test]
+fn ill_conditioned_control_hessian() {
+    let mut rng = SplitMix64::new(8);
+    // R with condition number 1e12: still well posed, no regularisation
+    // needed thanks to B' P B.
+    let mut qp = with_control_box(random_ocp_qp(&mut rng, 4, 2, 20), 0.5);
+    for k in 0..20 {
+        qp.r[k] = nalgebra::DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![1e3, 1e-9]));
+        qp.s[k].fill(0.0);
+    }
+    let (sol, _) = solve(&qp);
+    assert_matches("cond(R) = 1e12", &qp, &sol, &clarabel_solve(&qp));
+
+    // A control with zero weight and no effect: its Hessian block is
+    // singular, the solver regularises, says so, and still meets the KKT
+    // conditions (u_1 is not unique, so only the objective is compared).
+    let mut qp = random_ocp_qp(&mut rng, 4, 2, 20);
+    for k in 0..20 {
+        qp.r[k][(1, 1)] = 0.0;
+        qp.r[k][(0, 1)] = 0.0;
+        qp.r[k][(1, 0)] = 0.0;
+        for i in 0..4 {
+            qp.s[k][(1, i)] = 0.0;
+            qp.b[k][(i, 1)] = 0.0;
+        }
+        qp.r_lin[k][1] = 0.0;
+    }
+    let (sol, solver) = solve(&qp);
+    assert_eq!(sol.status, QpStatus::Solved);
+    assert!(solver.info().regularised_pivots > 0);
+    assert!(solver.total_regularised_pivots() > 0);
+    let kkt = kkt_residuals(&qp, &sol);
+    assert!(kkt.within(KKT_TOL, KKT_REL_TOL), "{kkt:?}");
+    let reference = clarabel_solve(&qp);
+    let rel = (sol.objective - reference.objective).abs() / reference.objective.abs().max(1.0);
+    assert!(rel <= OBJ_REL_TOL, "objective rel {rel:e}");
+    assert!((sol.u[0][0] - reference.u[0][0]).abs() <= U0_TOL);
+}
+
+#[test]
+fn semidefinite_state_cost() {
+    // Q = 0 on every stage but the last (pure control cost): the state
+    // pivots are truncated, which is exact.
+    let mut rng = SplitMix64::new(9);
+    let mut qp = with_control_box(random_ocp_qp(&mut rng, 4, 2, 15), 0.4);
+    for k in 0..15 {
+        qp.q[k].fill(0.0);
+        qp.s[k].fill(0.0);
+        qp.q_lin[k].fill(0.0);
+    }
+    qp.q[15].fill(0.0);
+    qp.q[15][(0, 0)] = 10.0;
+    let (sol, solver) = solve(&qp);
+    assert_matches("PSD Q", &qp, &sol, &clarabel_solve(&qp));
+    assert!(solver.info().truncated_pivots > 0);
+    assert_eq!(solver.info().regularised_pivots, 0);
+}
+
+#[test]
+fn invalid_input_is_refused() {
+    let mut rng = SplitMix64::new(10);
+    let good = with_control_box(random_ocp_qp(&mut rng, 4, 2, 10), 1.0);
+    type Corrupt = fn(&mut OcpQp);
+    let cases: [(&str, Corrupt); 12] = [
+        ("NaN in A", |qp| qp.a[3][(1, 2)] = f64::NAN),
+        ("Inf in B", |qp| qp.b[9][(0, 1)] = f64::INFINITY),
+        ("NaN in Q_N", |qp| qp.q[10][(2, 2)] = f64::NAN),
+        ("NaN in r", |qp| qp.r_lin[0][1] = f64::NAN),
+        ("NaN in x0", |qp| qp.x0[0] = f64::NAN),
+        ("NaN bound", |qp| qp.u_lower[2][0] = f64::NAN),
+        ("NaN state bound", |qp| qp.x_upper[2][0] = f64::NAN),
+        ("crossed control bounds", |qp| {
+            qp.u_lower[4][1] = 1.0;
+            qp.u_upper[4][1] = -1.0;
+        }),
+        ("negative penalty", |qp| qp.soft_l1[1] = -1.0),
+        ("asymmetric R", |qp| qp.r[1][(0, 1)] += 1.0),
+        ("wrong horizon", |qp| qp.horizon = 9),
+        ("wrong vector size", |qp| {
+            qp.c[2] = nalgebra::DVector::zeros(3);
+        }),
+    ];
+    let mut solver = RiccatiSolver::new(4, 2, 10, RiccatiSettings::default());
+    let mut sol = QpSolution::new(4, 2, 10);
+    for (what, corrupt) in cases {
+        let mut qp = good.clone();
+        corrupt(&mut qp);
+        assert_eq!(
+            solver.solve(&qp, &mut sol),
+            QpStatus::InvalidInput,
+            "{what}"
+        );
+        assert_eq!(sol.status, QpStatus::InvalidInput, "{what}");
+        assert!(!sol.status.is_usable());
+    }
+    // The solver is still fine afterwards.
+    assert_eq!(solver.solve(&good, &mut sol), QpStatus::Solved);
+    // A QP of other dimensions is refused too.
+    let other = random_ocp_qp(&mut rng, 4, 2, 11);
+    assert_eq!(solver.solve(&other, &mut sol), QpStatus::InvalidInput);
+}
+
+#[test]
+fn iteration_limit_is_reported() {
+    let mut rng = SplitMix64::new(11);
+    let qp = with_control_box(random_ocp_qp(&mut rng, 4, 2, 20), 0.2);
+    let settings = RiccatiSettings {
+        max_iterations: 2,
+        ..Default::default()
+    };
+    let mut solver = RiccatiSolver::new(4, 2, 20, settings);
+    let mut sol = QpSolution::new(4, 2, 20);
+    assert_eq!(solver.solve(&qp, &mut sol), QpStatus::MaxIterations);
+    assert_eq!(sol.iterations, 2);
+    assert!(sol.primal_residual > 1e-6 || sol.dual_residual > 1e-6);
+}
+
+/// Solves every QP of a record file with both backends; returns (count,
+/// worst first-control difference, worst KKT residual, max iterations).
+fn check_record(path: &Path) -> (usize, f64, f64, usize) {
+    let mut reader = QpRecordReader::open(path).expect("readable QP record");
+    let mut solver: Option<RiccatiSolver> = None;
+    let mut sol = QpSolution::new(1, 1, 1);
+    let (mut count, mut worst_u0, mut worst_kkt, mut max_iter) = (0, 0.0f64, 0.0f64, 0);
+    while let Some(qp) = reader.next_qp().expect("valid QP record") {
+        let fits = solver
+            .as_ref()
+            .is_some_and(|s| s.dimensions() == (qp.nx, qp.nu, qp.horizon));
+        if !fits {
+            solver = Some(RiccatiSolver::new(
+                qp.nx,
+                qp.nu,
+                qp.horizon,
+                Default::default(),
+            ));
+            sol = QpSolution::new(qp.nx, qp.nu, qp.horizon);
+        }
+        let s = solver.as_mut().expect("solver created above");
+        s.solve(&qp, &mut sol);
+        let reference = clarabel_solve(&qp);
+        assert_matches(
+            &format!("{} QP {count}", path.display()),
+            &qp,
+            &sol,
+            &reference,
+        );
+        worst_u0 = worst_u0.max((&sol.u[0] - &reference.u[0]).amax());
+        worst_kkt = worst_kkt.max(kkt_residuals(&qp, &sol).max());
+        max_iter = max_iter.max(sol.iterations);
+        count += 1;
+    }
+    (count, worst_u0, worst_kkt, max_iter)
+}
+
+#[test]
+fn synthetic_pendulum_set_matches_clarabel() {
+    // 320 random double-pendulum linearisations (N = 80, dt = 0.025):
+    // near-zero and large initial deviations, |tau| <= 1 and <= 0.2, with
+    // and without soft velocity bounds; written to a record file and read
+    // back, exercising the replay machinery.
+    let mut rng = SplitMix64::new(12);
+    let path = std::env::temp_dir().join(format!("eigenmpc-qp-set-{}.bin", std::process::id()));
+    let mut writer = QpRecordWriter::create(&path).expect("temp file");
+    let count = 320;
+    for i in 0..count {
+        let opts = PendulumQpOptions {
+            tau_max: if i % 2 == 0 { 1.0 } else { 0.2 },
+            initial_deviation: if i % 4 < 2 { 0.01 } else { 1.0 },
+            velocity_bound: if i % 8 < 4 { 6.0 } else { f64::INFINITY },
+            ..Default::default()
+        };
+        writer.write(&pendulum_rti_qp(&mut rng, &opts)).unwrap();
+    }
+    writer.finish().unwrap();
+    let (n, u0, kkt, iters) = check_record(&path);
+    std::fs::remove_file(&path).ok();
+    assert_eq!(n, count);
+    println!(
+        "synthetic set: {n} QPs, max |du0| {u0:.1e}, max KKT {kkt:.1e}, max iterations {iters}"
+    );
+}
+
+/// The recorded RTI QPs of the paper scenarios (issue 5 acceptance), when
+/// the controller has produced them: `EIGENMPC_QP_RECORD` or
+/// `tests/data/rti_qps.bin`.
+#[test]
+fn recorded_rti_set_matches_clarabel() {
+    let path = std::env::var_os("EIGENMPC_QP_RECORD")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/rti_qps.bin"));
+    if !path.exists() {
+        println!("no recorded QP set at {}; skipped", path.display());
+        return;
+    }
+    let (n, u0, kkt, iters) = check_record(&path);
+    assert!(n > 0, "empty QP record");
+    println!(
+        "recorded set: {n} QPs, max |du0| {u0:.1e}, max KKT {kkt:.1e}, max iterations {iters}"
+    );
+}
