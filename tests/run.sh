@@ -21,6 +21,7 @@ apt_install() {
 dpkg -s libclang-dev >/dev/null 2>&1 || apt_install libclang-dev
 # The symbol test lists the FMU's exports with nm.
 command -v nm >/dev/null 2>&1 || apt_install binutils
+command -v gcc >/dev/null 2>&1 || apt_install gcc
 
 echo "== cargo fmt --check"
 cargo fmt --all -- --check
@@ -30,6 +31,14 @@ echo "== cargo test"
 cargo test --workspace
 echo "== fmu-build (release cdylibs, target/fmu/*.fmu, include/eigenmpc.h)"
 cargo run -p fmu-build
+
+echo "== C host test (gcc, include/eigenmpc.h, linked FMU library)"
+target_dir=${CARGO_TARGET_DIR:-target}
+guid=$(grep -o 'guid="[^"]*"' modelDescription/DoublePendulum.xml | cut -d'"' -f2)
+gcc -std=c11 -Wall -Wextra -Werror -Iinclude tests/c/plant_loop.c \
+    -L"$target_dir/release" -ldouble_pendulum_fmu -Wl,-rpath,"$(cd "$target_dir/release" && pwd)" \
+    -lm -o "$target_dir/plant_loop"
+"$target_dir/plant_loop" "$guid"
 
 echo "== Python test environment (.venv)"
 if [ ! -x .venv/bin/python ]; then
