@@ -1,0 +1,690 @@
+//! One FMU instance: the FMI 2.0 Co-Simulation state machine, argument
+//! checks and value-reference dispatch around a [`Model`]. This is the safe
+//! Rust API; [`crate::abi`] wraps it for C.
+
+use crate::logger::{Logger, Status};
+use crate::values::Values;
+use crate::variables::{BaseType, Causality, Initial, ModelDescription, Value, Variability};
+use std::fmt;
+
+/// The FMI 2.0 Co-Simulation states an instance can be in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum State {
+    /// After `fmi2Instantiate` or `fmi2Reset`.
+    Instantiated,
+    /// Between `fmi2EnterInitializationMode` and `fmi2ExitInitializationMode`.
+    InitializationMode,
+    /// Ready for `fmi2DoStep`.
+    StepComplete,
+    /// The last `fmi2DoStep` returned `fmi2Discard`.
+    StepFailed,
+    /// After `fmi2Terminate`.
+    Terminated,
+    /// A call returned `fmi2Error`: only getters (for diagnostics),
+    /// `fmi2Reset` and `fmi2FreeInstance` are allowed.
+    Error,
+}
+
+impl fmt::Display for State {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let s = match self {
+            State::Instantiated => "instantiated",
+            State::InitializationMode => "initializationMode",
+            State::StepComplete => "stepComplete",
+            State::StepFailed => "stepFailed",
+            State::Terminated => "terminated",
+            State::Error => "error",
+        };
+        f.write_str(s)
+    }
+}
+
+/// Settings of `fmi2SetupExperiment`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Experiment {
+    /// Tolerance requested by the host, if any.
+    pub tolerance: Option<f64>,
+    /// Start time (s).
+    pub start_time: f64,
+    /// Stop time (s), if defined.
+    pub stop_time: Option<f64>,
+}
+
+impl Default for Experiment {
+    fn default() -> Self {
+        Self {
+            tolerance: None,
+            start_time: 0.0,
+            stop_time: None,
+        }
+    }
+}
+
+/// What a model sees of its environment during a call.
+pub struct Context<'a> {
+    /// The host's logger (use `warning` to make the call return `fmi2Warning`).
+    pub log: &'a Logger,
+    /// The experiment set up by the host.
+    pub experiment: &'a Experiment,
+}
+
+/// Why a model call failed.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ModelError {
+    /// Invalid parameters or a failed computation: `fmi2Error`.
+    Error(String),
+    /// `fmi2DoStep` only reached `last_successful_time`: `fmi2Discard`.
+    Discard {
+        /// What went wrong.
+        message: String,
+        /// Time up to which the outputs are valid.
+        last_successful_time: f64,
+    },
+}
+
+impl fmt::Display for ModelError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ModelError::Error(m) => f.write_str(m),
+            ModelError::Discard {
+                message,
+                last_successful_time,
+            } => write!(f, "{message} (valid up to t = {last_successful_time})"),
+        }
+    }
+}
+
+/// A co-simulation model behind the FMI 2.0 plumbing.
+///
+/// The plumbing owns the [`Values`]: it checks every value the host sets
+/// (type, value reference, state, causality, finiteness, min/max) before it
+/// reaches the store, so a model only validates relations between values.
+pub trait Model: Sized + Send + 'static {
+    /// The model's identity and variable table (drives dispatch and XML).
+    fn description() -> ModelDescription;
+
+    /// Builds the model from the parameters and inputs in `values` and writes
+    /// the outputs for them. Called at `fmi2ExitInitializationMode`, and
+    /// earlier when the host reads a calculated value in initialization mode.
+    fn initialize(values: &mut Values, ctx: &Context) -> Result<Self, ModelError>;
+
+    /// Advances from `t` to `t + h` with the current inputs and writes the
+    /// outputs at `t + h`. Must not allocate (real-time discipline).
+    fn do_step(
+        &mut self,
+        values: &mut Values,
+        t: f64,
+        h: f64,
+        ctx: &Context,
+    ) -> Result<(), ModelError>;
+
+    /// Tunable parameters changed between steps: validate and take them over.
+    /// On error the plumbing restores the previous values.
+    fn update_tunables(&mut self, values: &mut Values, ctx: &Context) -> Result<(), ModelError> {
+        let _ = (values, ctx);
+        Ok(())
+    }
+}
+
+/// One instance of model `M` with its state machine.
+pub struct Instance<M: Model> {
+    log: Logger,
+    description: ModelDescription,
+    values: Values,
+    state: State,
+    model: Option<M>,
+    /// In initialization mode: `model` reflects the current values.
+    model_current: bool,
+    experiment: Experiment,
+    time: f64,
+    last_successful_time: f64,
+    terminate_requested: bool,
+}
+
+// Instances may be driven from any thread (one at a time).
+const _: () = {
+    const fn assert_send<T: Send>() {}
+    struct Probe;
+    impl Model for Probe {
+        fn description() -> ModelDescription {
+            unreachable!()
+        }
+        fn initialize(_: &mut Values, _: &Context) -> Result<Self, ModelError> {
+            unreachable!()
+        }
+        fn do_step(
+            &mut self,
+            _: &mut Values,
+            _: f64,
+            _: f64,
+            _: &Context,
+        ) -> Result<(), ModelError> {
+            unreachable!()
+        }
+    }
+    assert_send::<Instance<Probe>>();
+};
+
+type CallResult = Result<Status, String>;
+
+const READABLE: &[State] = &[
+    State::InitializationMode,
+    State::StepComplete,
+    State::StepFailed,
+    State::Terminated,
+    State::Error,
+];
+
+impl<M: Model> Instance<M> {
+    /// `fmi2Instantiate`: checks the GUID against the model's; logs and
+    /// returns `None` on mismatch or an invalid variable table.
+    pub fn new(log: Logger, guid: &str) -> Option<Self> {
+        let description = M::description();
+        if let Err(e) = description.validate() {
+            log.error(&format!("fmi2Instantiate: invalid variable table: {e}"));
+            return None;
+        }
+        let expected = crate::xml::guid(&description);
+        if guid != expected {
+            log.error(&format!(
+                "fmi2Instantiate: GUID {guid} does not match this binary's {expected} \
+                 (modelDescription.xml and binary come from different builds)"
+            ));
+            return None;
+        }
+        log.event(&format!(
+            "fmi2Instantiate: instance of {} created",
+            description.model_name
+        ));
+        let values = Values::new(&description);
+        Some(Self {
+            log,
+            description,
+            values,
+            state: State::Instantiated,
+            model: None,
+            model_current: false,
+            experiment: Experiment::default(),
+            time: 0.0,
+            last_successful_time: 0.0,
+            terminate_requested: false,
+        })
+    }
+
+    /// The current state.
+    pub fn state(&self) -> State {
+        self.state
+    }
+
+    /// The logger (for messages outside a call).
+    pub fn logger(&self) -> &Logger {
+        &self.log
+    }
+
+    /// The variable table.
+    pub fn description(&self) -> &ModelDescription {
+        &self.description
+    }
+
+    /// The model, once initialized.
+    pub fn model(&self) -> Option<&M> {
+        self.model.as_ref()
+    }
+
+    /// Current communication time.
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// Finishes a call: an error is logged and moves the instance to the
+    /// error state; a warning logged during the call upgrades `fmi2OK`.
+    fn conclude(&mut self, result: CallResult) -> Status {
+        let warned = self.log.take_warned();
+        match result {
+            Ok(Status::Ok) if warned => Status::Warning,
+            Ok(s) => s,
+            Err(message) => {
+                self.log.error(&message);
+                self.state = State::Error;
+                Status::Error
+            }
+        }
+    }
+
+    /// Reports a failure found outside the instance methods (null pointer,
+    /// panic): logs it and enters the error state.
+    pub fn fail(&mut self, message: &str) -> Status {
+        self.conclude(Err(message.to_string()))
+    }
+
+    fn require(&self, func: &str, allowed: &[State]) -> Result<(), String> {
+        if allowed.contains(&self.state) {
+            Ok(())
+        } else {
+            let names: Vec<String> = allowed.iter().map(|s| s.to_string()).collect();
+            Err(format!(
+                "{func}: not allowed in state {} (allowed in: {})",
+                self.state,
+                names.join(", ")
+            ))
+        }
+    }
+
+    /// `fmi2SetDebugLogging`.
+    pub fn set_debug_logging(&mut self, on: bool, categories: &[&str]) -> Status {
+        let r = self
+            .log
+            .set_debug_logging(on, categories)
+            .map(|()| Status::Ok)
+            .map_err(|e| format!("fmi2SetDebugLogging: {e}"));
+        self.conclude(r)
+    }
+
+    /// `fmi2SetupExperiment`.
+    pub fn setup_experiment(
+        &mut self,
+        tolerance: Option<f64>,
+        start_time: f64,
+        stop_time: Option<f64>,
+    ) -> Status {
+        let r = (|| {
+            self.require("fmi2SetupExperiment", &[State::Instantiated])?;
+            self.log.trace(|| {
+                format!("fmi2SetupExperiment(tolerance = {tolerance:?}, start = {start_time}, stop = {stop_time:?})")
+            });
+            if !start_time.is_finite() {
+                return Err(format!(
+                    "fmi2SetupExperiment: startTime = {start_time} is not finite"
+                ));
+            }
+            if let Some(tol) = tolerance
+                && !(tol.is_finite() && tol > 0.0)
+            {
+                return Err(format!(
+                    "fmi2SetupExperiment: tolerance = {tol} must be finite and > 0"
+                ));
+            }
+            if let Some(stop) = stop_time
+                && !(stop.is_finite() && stop >= start_time)
+            {
+                return Err(format!(
+                    "fmi2SetupExperiment: stopTime = {stop} must be finite and >= startTime = {start_time}"
+                ));
+            }
+            self.experiment = Experiment {
+                tolerance,
+                start_time,
+                stop_time,
+            };
+            Ok(Status::Ok)
+        })();
+        self.conclude(r)
+    }
+
+    /// `fmi2EnterInitializationMode`.
+    pub fn enter_initialization_mode(&mut self) -> Status {
+        let r = self
+            .require("fmi2EnterInitializationMode", &[State::Instantiated])
+            .map(|()| {
+                self.state = State::InitializationMode;
+                self.time = self.experiment.start_time;
+                self.last_successful_time = self.time;
+                self.model_current = false;
+                self.log.event("entered initialization mode");
+                Status::Ok
+            });
+        self.conclude(r)
+    }
+
+    fn compute_initial(&mut self, func: &str) -> Result<(), String> {
+        let ctx = Context {
+            log: &self.log,
+            experiment: &self.experiment,
+        };
+        let model = M::initialize(&mut self.values, &ctx).map_err(|e| format!("{func}: {e}"))?;
+        self.model = Some(model);
+        self.model_current = true;
+        Ok(())
+    }
+
+    /// `fmi2ExitInitializationMode`: builds the model (parameter validation)
+    /// and computes the outputs.
+    pub fn exit_initialization_mode(&mut self) -> Status {
+        let r = (|| {
+            self.require("fmi2ExitInitializationMode", &[State::InitializationMode])?;
+            if !self.model_current {
+                self.compute_initial("fmi2ExitInitializationMode")?;
+            }
+            self.state = State::StepComplete;
+            self.terminate_requested = false;
+            self.log.event("initialization done, ready to step");
+            Ok(Status::Ok)
+        })();
+        self.conclude(r)
+    }
+
+    /// `fmi2Terminate`.
+    pub fn terminate(&mut self) -> Status {
+        let r = self
+            .require("fmi2Terminate", &[State::StepComplete, State::StepFailed])
+            .map(|()| {
+                self.state = State::Terminated;
+                self.log.event("terminated");
+                Status::Ok
+            });
+        self.conclude(r)
+    }
+
+    /// `fmi2Reset`: back to the instantiated state with the start values.
+    pub fn reset(&mut self) -> Status {
+        self.values = Values::new(&self.description);
+        self.model = None;
+        self.model_current = false;
+        self.experiment = Experiment::default();
+        self.time = 0.0;
+        self.last_successful_time = 0.0;
+        self.terminate_requested = false;
+        self.state = State::Instantiated;
+        self.log.event("reset to the start values");
+        self.conclude(Ok(Status::Ok))
+    }
+
+    /// Generic getter: `write(k, value)` receives the value of `vrs[k]`.
+    pub fn get(
+        &mut self,
+        func: &'static str,
+        base: BaseType,
+        vrs: &[u32],
+        mut write: impl FnMut(usize, Value),
+    ) -> Status {
+        let r = (|| {
+            self.require(func, READABLE)?;
+            let mut indices_ok = true;
+            let mut needs_model = false;
+            for &vr in vrs {
+                match self.values.index(base, vr) {
+                    Some(i) => {
+                        let v = &self.description.variables[i];
+                        needs_model |= v.effective_initial() == Some(Initial::Calculated);
+                    }
+                    None => indices_ok = false,
+                }
+            }
+            if !indices_ok {
+                let vr = vrs
+                    .iter()
+                    .find(|&&vr| self.values.index(base, vr).is_none())
+                    .copied()
+                    .unwrap_or_default();
+                return Err(format!("{func}: unknown {base:?} value reference {vr}"));
+            }
+            if self.state == State::InitializationMode && needs_model && !self.model_current {
+                self.compute_initial(func)?;
+            }
+            for (k, &vr) in vrs.iter().enumerate() {
+                let i = self.values.index(base, vr).expect("checked above");
+                write(k, self.values.at(i));
+            }
+            Ok(Status::Ok)
+        })();
+        self.conclude(r)
+    }
+
+    /// Generic setter: `value(k)` is the value for `vrs[k]`. All values are
+    /// checked before any is stored, so a rejected call changes nothing.
+    pub fn set(
+        &mut self,
+        func: &'static str,
+        base: BaseType,
+        vrs: &[u32],
+        value: impl Fn(usize) -> Value,
+    ) -> Status {
+        let r = (|| {
+            self.require(
+                func,
+                &[
+                    State::Instantiated,
+                    State::InitializationMode,
+                    State::StepComplete,
+                ],
+            )?;
+            let mut tunables = false;
+            for (k, &vr) in vrs.iter().enumerate() {
+                let i = self
+                    .values
+                    .index(base, vr)
+                    .ok_or_else(|| format!("{func}: unknown {base:?} value reference {vr}"))?;
+                let var = &self.description.variables[i];
+                let settable = var.variability != Variability::Constant
+                    && match self.state {
+                        State::Instantiated => {
+                            var.causality == Causality::Input
+                                || matches!(
+                                    var.effective_initial(),
+                                    Some(Initial::Exact | Initial::Approx)
+                                )
+                        }
+                        State::InitializationMode => {
+                            var.causality == Causality::Input
+                                || var.effective_initial() == Some(Initial::Exact)
+                        }
+                        _ => {
+                            var.causality == Causality::Input
+                                || (var.causality == Causality::Parameter
+                                    && var.variability == Variability::Tunable)
+                        }
+                    };
+                if !settable {
+                    return Err(format!(
+                        "{func}: {} (value reference {vr}, causality {:?}, variability {:?}) cannot be set in state {}",
+                        var.name, var.causality, var.variability, self.state
+                    ));
+                }
+                var.check_value(value(k))
+                    .map_err(|e| format!("{func}: rejected: {e}"))?;
+                tunables |=
+                    self.state == State::StepComplete && var.causality == Causality::Parameter;
+            }
+            // Only a tunable change (rare, between steps) may allocate the backup.
+            let backup: Vec<(usize, Value)> = if tunables {
+                vrs.iter()
+                    .map(|&vr| {
+                        let i = self.values.index(base, vr).expect("checked above");
+                        (i, self.values.at(i))
+                    })
+                    .collect()
+            } else {
+                Vec::new()
+            };
+            for (k, &vr) in vrs.iter().enumerate() {
+                let i = self.values.index(base, vr).expect("checked above");
+                self.values.set_at(i, value(k));
+            }
+            self.model_current &= self.state == State::StepComplete;
+            if tunables {
+                let ctx = Context {
+                    log: &self.log,
+                    experiment: &self.experiment,
+                };
+                let model = self
+                    .model
+                    .as_mut()
+                    .ok_or_else(|| format!("{func}: no model in step mode"))?;
+                if let Err(e) = model.update_tunables(&mut self.values, &ctx) {
+                    for (i, old) in backup {
+                        self.values.set_at(i, old);
+                    }
+                    return Err(format!("{func}: tunable parameter change rejected: {e}"));
+                }
+                self.log
+                    .event(&format!("{func}: tunable parameters updated"));
+            }
+            Ok(Status::Ok)
+        })();
+        self.conclude(r)
+    }
+
+    /// `fmi2GetReal`.
+    pub fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> Status {
+        if vrs.len() != out.len() {
+            return self.fail("fmi2GetReal: value array length differs from vr array length");
+        }
+        self.get("fmi2GetReal", BaseType::Real, vrs, |k, v| {
+            if let Value::Real(x) = v {
+                out[k] = x;
+            }
+        })
+    }
+
+    /// `fmi2SetReal`.
+    pub fn set_real(&mut self, vrs: &[u32], values: &[f64]) -> Status {
+        if vrs.len() != values.len() {
+            return self.fail("fmi2SetReal: value array length differs from vr array length");
+        }
+        self.set("fmi2SetReal", BaseType::Real, vrs, |k| {
+            Value::Real(values[k])
+        })
+    }
+
+    /// `fmi2GetInteger`.
+    pub fn get_integer(&mut self, vrs: &[u32], out: &mut [i32]) -> Status {
+        if vrs.len() != out.len() {
+            return self.fail("fmi2GetInteger: value array length differs from vr array length");
+        }
+        self.get("fmi2GetInteger", BaseType::Integer, vrs, |k, v| {
+            if let Value::Integer(x) = v {
+                out[k] = x;
+            }
+        })
+    }
+
+    /// `fmi2SetInteger`.
+    pub fn set_integer(&mut self, vrs: &[u32], values: &[i32]) -> Status {
+        if vrs.len() != values.len() {
+            return self.fail("fmi2SetInteger: value array length differs from vr array length");
+        }
+        self.set("fmi2SetInteger", BaseType::Integer, vrs, |k| {
+            Value::Integer(values[k])
+        })
+    }
+
+    /// `fmi2GetBoolean`.
+    pub fn get_boolean(&mut self, vrs: &[u32], out: &mut [bool]) -> Status {
+        if vrs.len() != out.len() {
+            return self.fail("fmi2GetBoolean: value array length differs from vr array length");
+        }
+        self.get("fmi2GetBoolean", BaseType::Boolean, vrs, |k, v| {
+            if let Value::Boolean(x) = v {
+                out[k] = x;
+            }
+        })
+    }
+
+    /// `fmi2SetBoolean`.
+    pub fn set_boolean(&mut self, vrs: &[u32], values: &[bool]) -> Status {
+        if vrs.len() != values.len() {
+            return self.fail("fmi2SetBoolean: value array length differs from vr array length");
+        }
+        self.set("fmi2SetBoolean", BaseType::Boolean, vrs, |k| {
+            Value::Boolean(values[k])
+        })
+    }
+
+    /// `fmi2GetString` / `fmi2SetString`: the models have no String
+    /// variables, so any value reference is unknown.
+    pub fn string_access(&mut self, func: &'static str, vrs: &[u32]) -> Status {
+        let r = match vrs.first() {
+            None => Ok(Status::Ok),
+            Some(vr) => Err(format!(
+                "{func}: unknown String value reference {vr} (this FMU has no String variables)"
+            )),
+        };
+        self.conclude(r)
+    }
+
+    /// `fmi2DoStep`: advances from `t` to `t + h`.
+    pub fn do_step(&mut self, t: f64, h: f64) -> Status {
+        let r = (|| {
+            self.require("fmi2DoStep", &[State::StepComplete])?;
+            self.log.trace(|| {
+                format!("fmi2DoStep(currentCommunicationPoint = {t}, communicationStepSize = {h})")
+            });
+            if !(h.is_finite() && h > 0.0) {
+                return Err(format!(
+                    "fmi2DoStep: communicationStepSize = {h} must be finite and > 0"
+                ));
+            }
+            if !t.is_finite() || (t - self.time).abs() > 1e-8 * t.abs().max(1.0) {
+                return Err(format!(
+                    "fmi2DoStep: currentCommunicationPoint = {t} differs from the FMU's time {} \
+                     (rolling back is not supported)",
+                    self.time
+                ));
+            }
+            let ctx = Context {
+                log: &self.log,
+                experiment: &self.experiment,
+            };
+            let model = self
+                .model
+                .as_mut()
+                .ok_or_else(|| "fmi2DoStep: no model in step mode".to_string())?;
+            match model.do_step(&mut self.values, t, h, &ctx) {
+                Ok(()) => {
+                    self.time = t + h;
+                    self.last_successful_time = self.time;
+                    Ok(Status::Ok)
+                }
+                Err(ModelError::Discard {
+                    message,
+                    last_successful_time,
+                }) => {
+                    self.state = State::StepFailed;
+                    self.time = last_successful_time;
+                    self.last_successful_time = last_successful_time;
+                    self.terminate_requested = true;
+                    self.log.log(
+                        crate::logger::Category::StatusWarning,
+                        Status::Discard,
+                        &format!(
+                            "fmi2DoStep: step discarded at t = {last_successful_time}: {message}"
+                        ),
+                    );
+                    Ok(Status::Discard)
+                }
+                Err(ModelError::Error(message)) => Err(format!("fmi2DoStep: {message}")),
+            }
+        })();
+        self.conclude(r)
+    }
+
+    /// `fmi2GetRealStatus(fmi2LastSuccessfulTime)`.
+    pub fn last_successful_time(&mut self) -> Result<f64, Status> {
+        let r = self.require(
+            "fmi2GetRealStatus",
+            &[State::StepComplete, State::StepFailed, State::Terminated],
+        );
+        match r {
+            Ok(()) => Ok(self.last_successful_time),
+            Err(e) => Err(self.conclude(Err(e))),
+        }
+    }
+
+    /// `fmi2GetBooleanStatus(fmi2Terminated)`: whether the slave asks to stop
+    /// (after a discarded step it cannot continue).
+    pub fn terminate_requested(&mut self) -> Result<bool, Status> {
+        let r = self.require(
+            "fmi2GetBooleanStatus",
+            &[State::StepComplete, State::StepFailed, State::Terminated],
+        );
+        match r {
+            Ok(()) => Ok(self.terminate_requested),
+            Err(e) => Err(self.conclude(Err(e))),
+        }
+    }
+
+    /// A function or status kind this FMU does not support: `fmi2Error`.
+    pub fn unsupported(&mut self, func: &str, why: &str) -> Status {
+        self.conclude(Err(format!("{func}: not supported: {why}")))
+    }
+}

@@ -1,0 +1,111 @@
+//! Test support: a host-side logger that records messages, for driving an
+//! FMU through its C functions in tests.
+
+use crate::ffi;
+use std::ffi::{CStr, c_void};
+use std::sync::Mutex;
+
+/// One message the FMU sent to the host.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LogLine {
+    /// `fmi2Status` of the message.
+    pub status: ffi::fmi2Status,
+    /// Log category.
+    pub category: String,
+    /// The text.
+    pub message: String,
+}
+
+/// Records every message an FMU instance logs. Keep it alive (and pinned:
+/// it is boxed) as long as the instance.
+#[derive(Debug, Default)]
+pub struct LogCapture {
+    lines: Mutex<Vec<LogLine>>,
+}
+
+/// Receives the messages of [`crate::Logger`], which passes no variadic
+/// arguments (the message is the format, '%' escaped). Rust cannot define
+/// C-variadic functions on stable; with no variadic arguments the variadic
+/// and non-variadic C calling conventions agree for these pointer and integer
+/// arguments on the supported 64-bit targets. Only for FMUs built on this crate.
+unsafe extern "C" fn capture(
+    environment: ffi::fmi2ComponentEnvironment,
+    _instance_name: ffi::fmi2String,
+    status: ffi::fmi2Status,
+    category: ffi::fmi2String,
+    message: ffi::fmi2String,
+) {
+    // SAFETY: environment is the LogCapture passed in `callbacks`; strings
+    // are NUL-terminated by the Logger.
+    unsafe {
+        let capture = &*(environment as *const LogCapture);
+        let line = LogLine {
+            status,
+            category: CStr::from_ptr(category).to_string_lossy().into_owned(),
+            message: CStr::from_ptr(message).to_string_lossy().replace("%%", "%"),
+        };
+        if let Ok(mut lines) = capture.lines.lock() {
+            lines.push(line);
+        }
+    }
+}
+
+type FixedArgLogger = unsafe extern "C" fn(
+    ffi::fmi2ComponentEnvironment,
+    ffi::fmi2String,
+    ffi::fmi2Status,
+    ffi::fmi2String,
+    ffi::fmi2String,
+);
+
+impl LogCapture {
+    /// A new, empty capture.
+    pub fn new() -> Box<Self> {
+        Box::default()
+    }
+
+    /// Callback functions for `fmi2Instantiate` that log into this capture.
+    pub fn callbacks(&self) -> ffi::fmi2CallbackFunctions {
+        // SAFETY: see `capture`: same argument registers for the arguments
+        // the Logger passes.
+        let logger: ffi::fmi2CallbackLogger = Some(unsafe {
+            std::mem::transmute::<
+                FixedArgLogger,
+                unsafe extern "C" fn(
+                    ffi::fmi2ComponentEnvironment,
+                    ffi::fmi2String,
+                    ffi::fmi2Status,
+                    ffi::fmi2String,
+                    ffi::fmi2String,
+                    ...
+                ),
+            >(capture)
+        });
+        ffi::fmi2CallbackFunctions {
+            logger,
+            allocateMemory: None,
+            freeMemory: None,
+            stepFinished: None,
+            componentEnvironment: self as *const LogCapture as *mut c_void,
+        }
+    }
+
+    /// All messages so far.
+    pub fn lines(&self) -> Vec<LogLine> {
+        self.lines.lock().map(|l| l.clone()).unwrap_or_default()
+    }
+
+    /// True if some message contains all of `needles`.
+    pub fn contains(&self, needles: &[&str]) -> bool {
+        self.lines()
+            .iter()
+            .any(|l| needles.iter().all(|n| l.message.contains(n)))
+    }
+
+    /// Forgets the messages so far.
+    pub fn clear(&self) {
+        if let Ok(mut l) = self.lines.lock() {
+            l.clear();
+        }
+    }
+}

@@ -1,0 +1,230 @@
+//! `fmu-build`: the packaging tool (xtask style).
+//!
+//! `cargo run -p fmu-build` release-builds every FMU crate (one
+//! `cargo build --release -p <crate>` each), writes each FMU's
+//! `modelDescription.xml` from its variable table (also into the checked-in
+//! `modelDescription/`), zips `target/fmu/<modelIdentifier>.fmu`
+//! (`modelDescription.xml`, `binaries/linux64/<modelIdentifier>.so`,
+//! `documentation/index.html`) and generates `include/eigenmpc.h` with
+//! cbindgen (config `cbindgen.toml`) next to the standard FMI 2.0 headers.
+//!
+//! Adding an FMU is one entry in [`FMUS`].
+
+use anyhow::{Context, Result, bail};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use zip::write::SimpleFileOptions;
+
+/// One FMU: its cargo package and what the build produces.
+struct FmuSpec {
+    /// `modelIdentifier` (FMU and shared-library file name).
+    model_identifier: &'static str,
+    /// Cargo package that builds the cdylib.
+    package: &'static str,
+    /// Package directory relative to the workspace root.
+    dir: &'static str,
+    /// File name of the cdylib cargo writes.
+    library: &'static str,
+    /// Binary of the package that writes modelDescription.xml and index.html.
+    describe: &'static str,
+    /// Prefix of the crate's public constants in the C header.
+    header_prefix: &'static str,
+}
+
+/// The FMUs this workspace ships.
+const FMUS: &[FmuSpec] = &[FmuSpec {
+    model_identifier: "DoublePendulum",
+    package: "double-pendulum-fmu",
+    dir: "plant",
+    library: "libdouble_pendulum_fmu.so",
+    describe: "double-pendulum-describe",
+    header_prefix: "DOUBLE_PENDULUM_",
+}];
+
+/// Where the FMU binaries go inside the archive (FMI 2.0 platform name).
+const PLATFORM: &str = "linux64";
+
+struct Workspace {
+    root: PathBuf,
+    target: PathBuf,
+    /// Directory of the fmi-sys package (ships the standard headers).
+    fmi_sys: PathBuf,
+}
+
+fn cargo() -> String {
+    std::env::var("CARGO").unwrap_or_else(|_| "cargo".into())
+}
+
+fn workspace() -> Result<Workspace> {
+    let out = Command::new(cargo())
+        .args(["metadata", "--format-version", "1"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .context("running cargo metadata")?;
+    if !out.status.success() {
+        bail!(
+            "cargo metadata failed: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let meta: serde_json::Value = serde_json::from_slice(&out.stdout)?;
+    let path = |key: &str| -> Result<PathBuf> {
+        Ok(PathBuf::from(
+            meta[key]
+                .as_str()
+                .with_context(|| format!("no {key} in cargo metadata"))?,
+        ))
+    };
+    let fmi_sys = meta["packages"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .find(|p| p["name"] == "fmi-sys")
+        .and_then(|p| p["manifest_path"].as_str())
+        .map(|m| {
+            Path::new(m)
+                .parent()
+                .unwrap_or(Path::new("."))
+                .to_path_buf()
+        })
+        .context("fmi-sys not in the dependency graph")?;
+    Ok(Workspace {
+        root: path("workspace_root")?,
+        target: path("target_directory")?,
+        fmi_sys,
+    })
+}
+
+fn release_build(ws: &Workspace, fmu: &FmuSpec) -> Result<()> {
+    println!("== cargo build --release -p {}", fmu.package);
+    let status = Command::new(cargo())
+        .args(["build", "--release", "-p", fmu.package])
+        .current_dir(&ws.root)
+        .status()
+        .context("running cargo build")?;
+    if !status.success() {
+        bail!("release build of {} failed", fmu.package);
+    }
+    Ok(())
+}
+
+/// Runs the FMU's describe binary; returns (modelDescription.xml, index.html).
+fn describe(ws: &Workspace, fmu: &FmuSpec) -> Result<(String, String)> {
+    let dir = ws
+        .target
+        .join("fmu")
+        .join(format!("{}.sources", fmu.model_identifier));
+    std::fs::create_dir_all(&dir)?;
+    let bin = ws.target.join("release").join(fmu.describe);
+    let status = Command::new(&bin)
+        .arg(&dir)
+        .status()
+        .with_context(|| format!("running {}", bin.display()))?;
+    if !status.success() {
+        bail!("{} failed", bin.display());
+    }
+    Ok((
+        std::fs::read_to_string(dir.join("modelDescription.xml"))?,
+        std::fs::read_to_string(dir.join("index.html"))?,
+    ))
+}
+
+fn package(ws: &Workspace, fmu: &FmuSpec, xml: &str, html: &str) -> Result<PathBuf> {
+    let library = ws.target.join("release").join(fmu.library);
+    let binary =
+        std::fs::read(&library).with_context(|| format!("reading {}", library.display()))?;
+    let path = ws
+        .target
+        .join("fmu")
+        .join(format!("{}.fmu", fmu.model_identifier));
+    let file = std::fs::File::create(&path)?;
+    let mut zip = zip::ZipWriter::new(file);
+    let opts = SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
+    let exe = opts.unix_permissions(0o755);
+    zip.start_file("modelDescription.xml", opts)?;
+    zip.write_all(xml.as_bytes())?;
+    zip.start_file(
+        format!("binaries/{PLATFORM}/{}.so", fmu.model_identifier),
+        exe,
+    )?;
+    zip.write_all(&binary)?;
+    zip.start_file("documentation/index.html", opts)?;
+    zip.write_all(html.as_bytes())?;
+    zip.finish()?;
+    Ok(path)
+}
+
+/// Updates the checked-in model description; true if it changed.
+fn update_checked_in(ws: &Workspace, fmu: &FmuSpec, xml: &str) -> Result<bool> {
+    let dir = ws.root.join("modelDescription");
+    std::fs::create_dir_all(&dir)?;
+    let path = dir.join(format!("{}.xml", fmu.model_identifier));
+    let old = std::fs::read_to_string(&path).unwrap_or_default();
+    if old == xml {
+        return Ok(false);
+    }
+    std::fs::write(&path, xml)?;
+    Ok(true)
+}
+
+/// `include/eigenmpc.h` with cbindgen, plus the standard FMI 2.0 headers it
+/// includes.
+fn header(ws: &Workspace) -> Result<PathBuf> {
+    let include = ws.root.join("include");
+    std::fs::create_dir_all(&include)?;
+    for h in [
+        "fmi2Functions.h",
+        "fmi2FunctionTypes.h",
+        "fmi2TypesPlatform.h",
+    ] {
+        std::fs::copy(
+            ws.fmi_sys.join("fmi-standard2/headers").join(h),
+            include.join(h),
+        )
+        .with_context(|| format!("copying {h} from fmi-sys"))?;
+    }
+    let out = include.join("eigenmpc.h");
+    let mut text = Vec::new();
+    for (i, fmu) in FMUS.iter().enumerate() {
+        let mut config = cbindgen::Config::from_file(ws.root.join("cbindgen.toml"))
+            .map_err(|e| anyhow::anyhow!("cbindgen.toml: {e}"))?;
+        config.export.prefix = Some(fmu.header_prefix.into());
+        if i > 0 {
+            // One include guard and preamble for the whole header.
+            config.include_guard = None;
+            config.header = None;
+            config.autogen_warning = None;
+            config.includes.clear();
+            config.no_includes = true;
+        }
+        let bindings = cbindgen::Builder::new()
+            .with_config(config)
+            .with_crate(ws.root.join(fmu.dir))
+            .generate()
+            .map_err(|e| anyhow::anyhow!("cbindgen on {}: {e}", fmu.package))?;
+        bindings.write(&mut text);
+    }
+    std::fs::write(&out, text)?;
+    Ok(out)
+}
+
+fn main() -> Result<()> {
+    let ws = workspace()?;
+    std::fs::create_dir_all(ws.target.join("fmu"))?;
+    for fmu in FMUS {
+        release_build(&ws, fmu)?;
+        let (xml, html) = describe(&ws, fmu)?;
+        if update_checked_in(&ws, fmu, &xml)? {
+            println!(
+                "updated modelDescription/{}.xml from the variable table: commit it",
+                fmu.model_identifier
+            );
+        }
+        let path = package(&ws, fmu, &xml, &html)?;
+        println!("wrote {}", path.display());
+    }
+    let h = header(&ws)?;
+    println!("wrote {}", h.display());
+    Ok(())
+}
