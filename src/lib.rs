@@ -16,3 +16,4 @@ pub mod mechanics;
 pub mod modes;
 pub mod mpc;
 pub mod qp;
+pub mod report;

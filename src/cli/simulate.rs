@@ -4,13 +4,12 @@
 use super::ModelArgs;
 use anyhow::{Context, bail};
 use clap::Args;
-use eigenmpc::mechanics::{DoublePendulum, Vector};
+use eigenmpc::mechanics::Vector;
 use eigenmpc::modes::{Chart, Family, linear_modes};
-use eigenmpc::mpc::closed_loop::{Sample, Summary, mode_and_chart, run, summarise};
+use eigenmpc::mpc::closed_loop::{Summary, mode_and_chart, run, summarise};
 use eigenmpc::mpc::{Controller, MpcConfig, Reference, Variant};
+use eigenmpc::report::{plot_run, summary_text, write_csv};
 use nalgebra::SVector;
-use plotters::prelude::*;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// Arguments of `eigenmpc simulate`.
@@ -169,212 +168,16 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
         write_csv(path, &trace).with_context(|| format!("writing {}", path.display()))?;
     }
     if let Some(path) = &args.plot {
-        plot(path, &trace, &mode.path, args.energy, &system)
+        plot_run(path, &trace, &mode.path, args.energy)
             .with_context(|| format!("plotting {}", path.display()))?;
     }
     Ok(())
 }
 
 fn print_summary(args: &SimulateArgs, variant: Variant, family: Family, s: &Summary<2>) {
-    let ms = |t: f64| t * 1e3;
     println!(
         "{variant} EigenMPC, {family}, E_ref = {} J, x0 = {}, {} s, N = {}, dt = {} s",
         args.energy, args.x0, args.duration, args.horizon, args.dt
     );
-    match s.time_to_5_percent {
-        Some(t) => println!("time to |E - E_ref| < 5 % for good: {t:.3} s"),
-        None => println!("time to |E - E_ref| < 5 % for good: not reached"),
-    }
-    println!(
-        "final energy error:              {:+.4} J",
-        s.final_energy_error
-    );
-    println!(
-        "RMS torque, last 5 s:            {:.4} / {:.4} N m",
-        s.rms_torque[0], s.rms_torque[1]
-    );
-    if let Some(d) = s.rms_distance {
-        println!("RMS distance to the mode, last 5 s: {d:.4} rad");
-    }
-    println!(
-        "solve time per sample:           median {:.3} ms, p95 {:.3} ms, p99 {:.3} ms, max {:.3} ms",
-        ms(s.solve_time[0]),
-        ms(s.solve_time[1]),
-        ms(s.solve_time[2]),
-        ms(s.solve_time[3])
-    );
-    if s.failures > 0 {
-        println!("samples with a failed solve:     {}", s.failures);
-    }
-}
-
-fn write_csv(path: &Path, trace: &[Sample<2, 4>]) -> std::io::Result<()> {
-    let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
-    writeln!(f, "time,q1,q2,qd1,qd2,tau1,tau2,energy,solve_ms")?;
-    for s in trace {
-        let z = &s.state;
-        writeln!(
-            f,
-            "{},{},{},{},{},{},{},{},{}",
-            s.time,
-            z[0],
-            z[1],
-            z[2],
-            z[3],
-            s.tau[0],
-            s.tau[1],
-            s.energy,
-            s.solve_time * 1e3
-        )?;
-    }
-    f.flush()
-}
-
-/// One plotted quantity of a sample.
-type SampleValue = fn(&Sample<2, 4>) -> f64;
-
-const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
-
-fn plot(
-    path: &Path,
-    trace: &[Sample<2, 4>],
-    mode: &[Vector<2>],
-    e_ref: f64,
-    system: &DoublePendulum,
-) -> anyhow::Result<()> {
-    // The font ships with the binary: no system fontconfig needed.
-    plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
-        .map_err(|_| anyhow::anyhow!("embedded font is invalid"))?;
-    let size = (1500, 900);
-    let svg = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("svg"));
-    if svg {
-        draw(
-            SVGBackend::new(path, size).into_drawing_area(),
-            trace,
-            mode,
-            e_ref,
-            system,
-        )
-    } else {
-        draw(
-            BitMapBackend::new(path, size).into_drawing_area(),
-            trace,
-            mode,
-            e_ref,
-            system,
-        )
-    }
-}
-
-fn draw<DB: DrawingBackend>(
-    root: DrawingArea<DB, plotters::coord::Shift>,
-    trace: &[Sample<2, 4>],
-    mode: &[Vector<2>],
-    e_ref: f64,
-    _system: &DoublePendulum,
-) -> anyhow::Result<()>
-where
-    DB::ErrorType: 'static,
-{
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow::anyhow!("{e:?}");
-    root.fill(&WHITE).map_err(err)?;
-    let panels = root.split_evenly((2, 3));
-    let t_end = trace.last().map_or(1.0, |s| s.time).max(1e-9);
-    let range = |vals: &mut dyn Iterator<Item = f64>| {
-        let (lo, hi) = vals.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-            (a.min(v), b.max(v))
-        });
-        let pad = ((hi - lo) * 0.05).max(1e-3);
-        (lo - pad)..(hi + pad)
-    };
-
-    // Joint-space path with the true eigenmode (both branches of the orbit).
-    {
-        let xs = range(
-            &mut trace
-                .iter()
-                .map(|s| s.state[0])
-                .chain(mode.iter().map(|q| q[0])),
-        );
-        let ys = range(
-            &mut trace
-                .iter()
-                .map(|s| s.state[1])
-                .chain(mode.iter().map(|q| q[1])),
-        );
-        let mut chart = ChartBuilder::on(&panels[0])
-            .caption("joint-space path", ("sans-serif", 20))
-            .margin(10)
-            .x_label_area_size(35)
-            .y_label_area_size(45)
-            .build_cartesian_2d(xs, ys)
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc("theta1 (rad)")
-            .y_desc("theta2 (rad)")
-            .draw()
-            .map_err(err)?;
-        chart
-            .draw_series(LineSeries::new(
-                trace.iter().map(|s| (s.state[0], s.state[1])),
-                BLUE.mix(0.6),
-            ))
-            .map_err(err)?
-            .label("EigenMPC")
-            .legend(|(x, y)| PathElement::new([(x, y), (x + 15, y)], BLUE));
-        chart
-            .draw_series(LineSeries::new(
-                mode.iter().map(|q| (q[0], q[1])),
-                RED.stroke_width(2),
-            ))
-            .map_err(err)?
-            .label("eigenmode at E_ref")
-            .legend(|(x, y)| PathElement::new([(x, y), (x + 15, y)], RED));
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .draw()
-            .map_err(err)?;
-    }
-
-    let series: [(&str, &str, SampleValue); 5] = [
-        ("energy", "E (J)", |s| s.energy),
-        ("theta1", "theta1 (rad)", |s| s.state[0]),
-        ("theta2", "theta2 (rad)", |s| s.state[1]),
-        ("tau1", "tau1 (N m)", |s| s.tau[0]),
-        ("tau2", "tau2 (N m)", |s| s.tau[1]),
-    ];
-    for (panel, (title, label, f)) in panels[1..].iter().zip(series.iter()) {
-        let mut ys = range(&mut trace.iter().map(f));
-        if *title == "energy" {
-            ys = ys.start.min(e_ref * 0.9)..ys.end.max(e_ref * 1.1);
-        }
-        let mut chart = ChartBuilder::on(panel)
-            .caption(*title, ("sans-serif", 20))
-            .margin(10)
-            .x_label_area_size(35)
-            .y_label_area_size(45)
-            .build_cartesian_2d(0.0..t_end, ys)
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc("time (s)")
-            .y_desc(*label)
-            .draw()
-            .map_err(err)?;
-        chart
-            .draw_series(LineSeries::new(trace.iter().map(|s| (s.time, f(s))), BLUE))
-            .map_err(err)?;
-        if *title == "energy" {
-            chart
-                .draw_series(LineSeries::new([(0.0, e_ref), (t_end, e_ref)], RED))
-                .map_err(err)?;
-        }
-    }
-    root.present().map_err(err)?;
-    Ok(())
+    print!("{}", summary_text(s));
 }

@@ -242,6 +242,19 @@ impl ControlStatus {
             ControlStatus::InvalidState => 3,
         }
     }
+
+    /// Inverse of [`ControlStatus::code`] for statuses read back from C/FMI
+    /// (the code does not carry the QP status: a QP failure comes back as
+    /// `QpFailed(QpStatus::NumericalError)`).
+    pub fn from_code(code: i32) -> Option<Self> {
+        match code {
+            0 => Some(ControlStatus::Solved),
+            1 => Some(ControlStatus::NotConverged),
+            2 => Some(ControlStatus::QpFailed(QpStatus::NumericalError)),
+            3 => Some(ControlStatus::InvalidState),
+            _ => None,
+        }
+    }
 }
 
 impl std::fmt::Display for ControlStatus {
