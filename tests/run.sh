@@ -63,5 +63,7 @@ if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
         echo "warning: libcosimpy did not install; the libcosim test will be skipped" >&2
     echo "$want" >"$stamp"
 fi
+echo "== release CLI (the Python tests compare with \`eigenmpc simulate\`)"
+cargo build --release --bin eigenmpc
 echo "== pytest"
 .venv/bin/python -m pytest tests/python -rs
