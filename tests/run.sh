@@ -32,13 +32,17 @@ cargo test --workspace
 echo "== fmu-build (release cdylibs, target/fmu/*.fmu, include/eigenmpc.h)"
 cargo run -p fmu-build
 
-echo "== C host test (gcc, include/eigenmpc.h, linked FMU library)"
+echo "== C host tests (gcc, include/eigenmpc.h, linked FMU libraries)"
 target_dir=${CARGO_TARGET_DIR:-target}
 guid=$(grep -o 'guid="[^"]*"' modelDescription/DoublePendulum.xml | cut -d'"' -f2)
 gcc -std=c11 -Wall -Wextra -Werror -Iinclude tests/c/plant_loop.c \
     -L"$target_dir/release" -ldouble_pendulum_fmu -Wl,-rpath,"$(cd "$target_dir/release" && pwd)" \
     -lm -o "$target_dir/plant_loop"
 "$target_dir/plant_loop" "$guid"
+gcc -std=c11 -Wall -Wextra -Werror -Iinclude tests/c/controller_loop.c \
+    -L"$target_dir/release" -leigenmpc_fmu -Wl,-rpath,"$(cd "$target_dir/release" && pwd)" \
+    -lm -o "$target_dir/controller_loop"
+"$target_dir/controller_loop"
 
 echo "== Python test environment (.venv)"
 if [ ! -x .venv/bin/python ]; then
@@ -59,5 +63,7 @@ if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
         echo "warning: libcosimpy did not install; the libcosim test will be skipped" >&2
     echo "$want" >"$stamp"
 fi
+echo "== release CLI (the Python tests compare with \`eigenmpc simulate\`)"
+cargo build --release --bin eigenmpc
 echo "== pytest"
 .venv/bin/python -m pytest tests/python -rs

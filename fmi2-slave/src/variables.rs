@@ -210,6 +210,13 @@ impl Variable {
         self
     }
 
+    /// Sets the variability (e.g. `Discrete` for a Real output that only
+    /// changes at communication points).
+    pub fn variability(mut self, variability: Variability) -> Self {
+        self.variability = variability;
+        self
+    }
+
     /// Sets the unit.
     pub fn unit(mut self, unit: impl Into<String>) -> Self {
         self.unit = Some(unit.into());

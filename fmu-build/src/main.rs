@@ -28,19 +28,35 @@ struct FmuSpec {
     library: &'static str,
     /// Binary of the package that writes modelDescription.xml and index.html.
     describe: &'static str,
-    /// Prefix of the crate's public constants in the C header.
+    /// Prefix of the crate's public items (value references, constants) in
+    /// the C header.
     header_prefix: &'static str,
+    /// Items that keep their name in the header (a plain C API's types).
+    header_unprefixed: &'static [&'static str],
 }
 
 /// The FMUs this workspace ships.
-const FMUS: &[FmuSpec] = &[FmuSpec {
-    model_identifier: "DoublePendulum",
-    package: "double-pendulum-fmu",
-    dir: "plant",
-    library: "libdouble_pendulum_fmu.so",
-    describe: "double-pendulum-describe",
-    header_prefix: "DOUBLE_PENDULUM_",
-}];
+const FMUS: &[FmuSpec] = &[
+    FmuSpec {
+        model_identifier: "DoublePendulum",
+        package: "double-pendulum-fmu",
+        dir: "plant",
+        library: "libdouble_pendulum_fmu.so",
+        describe: "double-pendulum-describe",
+        header_prefix: "DOUBLE_PENDULUM_",
+        header_unprefixed: &[],
+    },
+    FmuSpec {
+        model_identifier: "EigenMPC",
+        package: "eigenmpc-fmu",
+        dir: "controller-fmu",
+        library: "libeigenmpc_fmu.so",
+        describe: "eigenmpc-describe",
+        header_prefix: "EIGENMPC_",
+        // The plain C API (controller-fmu/src/capi.rs) keeps its names.
+        header_unprefixed: &["EigenMpc", "EigenMpcConfig", "EigenMpcStepInfo"],
+    },
+];
 
 /// Where the FMU binaries go inside the archive (FMI 2.0 platform name).
 const PLATFORM: &str = "linux64";
@@ -190,6 +206,13 @@ fn header(ws: &Workspace) -> Result<PathBuf> {
         let mut config = cbindgen::Config::from_file(ws.root.join("cbindgen.toml"))
             .map_err(|e| anyhow::anyhow!("cbindgen.toml: {e}"))?;
         config.export.prefix = Some(fmu.header_prefix.into());
+        for name in fmu.header_unprefixed {
+            config
+                .export
+                .rename
+                .insert(name.to_string(), name.to_string());
+        }
+        config.export.renaming_overrides_prefixing = true;
         if i > 0 {
             // One include guard and preamble for the whole header.
             config.include_guard = None;

@@ -5,7 +5,8 @@ use anyhow::Context;
 use clap::Args;
 use eigenmpc::mechanics::Vector;
 use eigenmpc::modes::{
-    Chart, ContinuationOptions, Family, eigenmode_family_with_progress, linear_modes,
+    Chart, ContinuationOptions, FMU_CHART_DEGREE, Family, eigenmode_family_with_progress,
+    fmu_chart_coef_name, linear_modes,
 };
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
@@ -35,9 +36,6 @@ pub struct ModesArgs {
     #[command(flatten)]
     model: ModelArgs,
 }
-
-/// Polynomial degree of the controller FMU's chart parameters `chart.coef[j,k]`, k = 0..=9.
-pub const FMU_CHART_DEGREE: usize = 9;
 
 /// Start values of the controller FMU for one eigenmode and its chart.
 fn fmu_start_values(
@@ -69,7 +67,7 @@ fn fmu_start_values(
         put(format!("c[{}]", j + 1), eigenvector[j]);
         for k in 0..=FMU_CHART_DEGREE {
             let a = chart.coefficients[j].get(k).copied().unwrap_or(0.0);
-            put(format!("chart.coef[{},{k}]", j + 1), a);
+            put(fmu_chart_coef_name(j + 1, k), a);
         }
     }
     Ok(values)

@@ -9,6 +9,16 @@ from fmpy import extract, read_model_description
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 
+# Measured figures the tests report (shown in the summary without -s).
+FIGURES: list[str] = []
+
+
+def pytest_terminal_summary(terminalreporter):
+    if FIGURES:
+        terminalreporter.section("measured figures")
+        for line in FIGURES:
+            terminalreporter.write_line(line)
+
 
 def fmu_dir() -> pathlib.Path:
     target = os.environ.get("CARGO_TARGET_DIR")
@@ -38,3 +48,31 @@ def plant_unzipped(plant_fmu, tmp_path_factory):
     extract(str(plant_fmu), unzipdir=str(directory))
     yield directory
     shutil.rmtree(directory, ignore_errors=True)
+
+
+@pytest.fixture(scope="session")
+def controller_fmu() -> pathlib.Path:
+    return fmu_path("EigenMPC")
+
+
+@pytest.fixture(scope="session")
+def controller_md(controller_fmu):
+    return read_model_description(str(controller_fmu))
+
+
+@pytest.fixture(scope="session")
+def controller_unzipped(controller_fmu, tmp_path_factory):
+    directory = tmp_path_factory.mktemp("EigenMPC")
+    extract(str(controller_fmu), unzipdir=str(directory))
+    yield directory
+    shutil.rmtree(directory, ignore_errors=True)
+
+
+@pytest.fixture(scope="session")
+def eigenmpc_cli() -> pathlib.Path:
+    """The release CLI (tests/run.sh builds it before pytest)."""
+    target = os.environ.get("CARGO_TARGET_DIR")
+    path = (pathlib.Path(target) if target else ROOT / "target") / "release" / "eigenmpc"
+    if not path.exists():
+        pytest.fail(f"{path} missing: run `cargo build --release --bin eigenmpc` first")
+    return path

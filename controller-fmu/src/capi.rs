@@ -1,0 +1,390 @@
+//! Plain C API: the EigenMPC controller without FMI, for embedding in a C
+//! control loop. Declared in `include/eigenmpc.h` (cbindgen).
+//!
+//! ```c
+//! EigenMpcConfig cfg = eigenmpc_config_default(EIGENMPC_VARIANT_CURVED);
+//! char err[256];
+//! EigenMpc *mpc = eigenmpc_create(&cfg, NULL, err, sizeof err); /* NULL chart: 14 J default */
+//! if (!mpc) { fprintf(stderr, "%s\n", err); return 1; }
+//! double z[4] = {0.05, 0.05, 0, 0}, tau[2];
+//! int status = eigenmpc_step(mpc, z, tau); /* every sample_period seconds */
+//! eigenmpc_free(mpc);
+//! ```
+//!
+//! Every function checks its pointers and catches panics: a failure is a
+//! return value (NULL, a negative status) and a message, never an abort.
+//! A handle may be used from any thread, one call at a time.
+
+use crate::settings::{CHART_COEFFICIENTS, PendulumController, Settings, Tuning};
+use crate::{STATUS_BAD_ARGUMENT, VARIANT_CURVED, VARIANT_STRAIGHT};
+use eigenmpc::mechanics::PlanarChainParams;
+use eigenmpc::mpc::{ControlOutput, ControlStatus, Variant};
+use nalgebra::SVector;
+use std::ffi::{CString, c_char};
+use std::panic::{AssertUnwindSafe, catch_unwind};
+
+/// Controller configuration for [`eigenmpc_create`]. Get the paper's values
+/// from [`eigenmpc_config_default`] and change what you need.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EigenMpcConfig {
+    /// `EIGENMPC_VARIANT_STRAIGHT` (1) or `EIGENMPC_VARIANT_CURVED` (2).
+    pub variant: i32,
+    /// Reference energy E_ref (J), >= 0.
+    pub e_ref: f64,
+    /// Exploration gain alpha of the straight cost (1/J), >= 0.
+    pub alpha: f64,
+    /// Torque-weight offset beta of the straight cost, >= 0.
+    pub beta: f64,
+    /// Energy weight w_E; negative: the paper's value of the variant (25 curved, 5 straight).
+    pub w_e: f64,
+    /// Position-distance weight w_x, >= 0.
+    pub w_x: f64,
+    /// Velocity-distance weight w_xd, >= 0.
+    pub w_xd: f64,
+    /// Torque weight w_F, > 0.
+    pub w_f: f64,
+    /// Torque bound |tau_j| <= tau_max (N m), > 0.
+    pub tau_max: f64,
+    /// Shooting intervals N of the horizon, 1..=10000.
+    pub horizon: u32,
+    /// Sample period and shooting interval (s), > 0.
+    pub sample_period: f64,
+    /// Controller model: point masses (kg).
+    pub masses: [f64; 2],
+    /// Controller model: link lengths (m).
+    pub lengths: [f64; 2],
+    /// Controller model: gravitational acceleration (m/s^2).
+    pub gravity: f64,
+    /// Linear eigenvector c (normalised by the controller).
+    pub eigenvector: [f64; 2],
+}
+
+/// Diagnostics of the last [`eigenmpc_step`].
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct EigenMpcStepInfo {
+    /// Status code (`EIGENMPC_STATUS_*`), as returned by the step.
+    pub status: i32,
+    /// Interior-point iterations of the step's QP(s).
+    pub qp_iterations: u32,
+    /// Wall-clock time of the step: preparation + feedback (s).
+    pub solve_time: f64,
+    /// Energy of the step's state under the controller's model (J).
+    pub energy: f64,
+}
+
+/// An EigenMPC controller (opaque). Create with [`eigenmpc_create`], free
+/// with [`eigenmpc_free`].
+pub struct EigenMpc {
+    controller: PendulumController,
+    variant: Variant,
+    info: EigenMpcStepInfo,
+    /// Message of the last failed call ("" if none), NUL-terminated.
+    last_error: CString,
+}
+
+impl EigenMpc {
+    fn fail(&mut self, message: String) -> i32 {
+        self.last_error = CString::new(message.replace('\0', " ")).unwrap_or_default();
+        STATUS_BAD_ARGUMENT
+    }
+}
+
+fn settings_from(config: &EigenMpcConfig) -> Result<Settings, String> {
+    let variant = match config.variant {
+        VARIANT_STRAIGHT => Variant::Straight,
+        VARIANT_CURVED => Variant::Curved,
+        v => {
+            return Err(format!(
+                "variant = {v}: expected EIGENMPC_VARIANT_STRAIGHT (1) or EIGENMPC_VARIANT_CURVED (2)"
+            ));
+        }
+    };
+    Ok(Settings {
+        variant,
+        tuning: tuning_from(config),
+        tau_max: config.tau_max,
+        horizon: config.horizon as usize,
+        sample_period: config.sample_period,
+        model: PlanarChainParams {
+            masses: config.masses,
+            lengths: config.lengths,
+            gravity: config.gravity,
+            ..Default::default()
+        },
+        eigenvector: config.eigenvector,
+        chart: Settings::paper(variant).chart,
+    })
+}
+
+fn tuning_from(config: &EigenMpcConfig) -> Tuning {
+    Tuning {
+        e_ref: config.e_ref,
+        alpha: config.alpha,
+        beta: config.beta,
+        w_e: config.w_e,
+        w_x: config.w_x,
+        w_xd: config.w_xd,
+        w_f: config.w_f,
+    }
+}
+
+/// Writes `message` into the caller's buffer (truncated, NUL-terminated).
+///
+/// # Safety
+/// `buffer` is null or valid for `len` bytes.
+unsafe fn write_error(buffer: *mut c_char, len: usize, message: &str) {
+    if buffer.is_null() || len == 0 {
+        return;
+    }
+    let bytes = message.as_bytes();
+    let n = bytes.len().min(len - 1);
+    // SAFETY: the caller guarantees `len` writable bytes; n + 1 <= len.
+    unsafe {
+        std::ptr::copy_nonoverlapping(bytes.as_ptr().cast::<c_char>(), buffer, n);
+        *buffer.add(n) = 0;
+    }
+}
+
+/// The paper's configuration (section V-A) for `variant` on the paper's
+/// double pendulum (m = l = 1, g = 9.81): N = 80, dt = 25 ms, |tau| <= 1 N m,
+/// E_ref = 14 J, w_E negative (paper default of the variant), in-phase
+/// eigenvector. An unknown variant is kept and refused by [`eigenmpc_create`].
+#[unsafe(no_mangle)]
+pub extern "C" fn eigenmpc_config_default(variant: i32) -> EigenMpcConfig {
+    let s = Settings::paper(Variant::Curved);
+    EigenMpcConfig {
+        variant,
+        e_ref: s.tuning.e_ref,
+        alpha: s.tuning.alpha,
+        beta: s.tuning.beta,
+        w_e: s.tuning.w_e,
+        w_x: s.tuning.w_x,
+        w_xd: s.tuning.w_xd,
+        w_f: s.tuning.w_f,
+        tau_max: s.tau_max,
+        horizon: s.horizon as u32,
+        sample_period: s.sample_period,
+        masses: s.model.masses,
+        lengths: s.model.lengths,
+        gravity: s.model.gravity,
+        eigenvector: s.eigenvector,
+    }
+}
+
+/// Creates a controller (all memory is allocated here; steps do not allocate).
+///
+/// `chart_coef` (curved only, may be NULL): 20 numbers, the chart
+/// coefficients of joint 1 for powers 0..9, then joint 2 (the FMU's
+/// `chart.coef[j,k]`, from `eigenmpc modes`); NULL selects the 14 J in-phase
+/// chart of the default model. On failure returns NULL and, if `error` is not
+/// NULL, writes the reason into `error` (at most `error_len` bytes, NUL-terminated).
+///
+/// # Safety
+/// `config` is NULL or points to an `EigenMpcConfig`; `chart_coef` is NULL or
+/// points to 20 doubles; `error` is NULL or valid for `error_len` bytes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn eigenmpc_create(
+    config: *const EigenMpcConfig,
+    chart_coef: *const f64,
+    error: *mut c_char,
+    error_len: usize,
+) -> *mut EigenMpc {
+    let result = catch_unwind(AssertUnwindSafe(|| -> Result<EigenMpc, String> {
+        if config.is_null() {
+            return Err("eigenmpc_create: config is NULL".into());
+        }
+        // SAFETY: non-null, and the caller guarantees it points to a config.
+        let config = unsafe { &*config };
+        let mut settings = settings_from(config)?;
+        if !chart_coef.is_null() {
+            // SAFETY: the caller guarantees 2 * CHART_COEFFICIENTS doubles.
+            let coef = unsafe { std::slice::from_raw_parts(chart_coef, 2 * CHART_COEFFICIENTS) };
+            for (j, row) in settings.chart.iter_mut().enumerate() {
+                row.copy_from_slice(&coef[j * CHART_COEFFICIENTS..(j + 1) * CHART_COEFFICIENTS]);
+            }
+        }
+        let controller = settings.build()?;
+        Ok(EigenMpc {
+            controller,
+            variant: settings.variant,
+            info: EigenMpcStepInfo::default(),
+            last_error: CString::default(),
+        })
+    }));
+    let message = match result {
+        Ok(Ok(mpc)) => return Box::into_raw(Box::new(mpc)),
+        Ok(Err(message)) => format!("eigenmpc_create: {message}"),
+        Err(_) => "eigenmpc_create: internal error (panic caught)".to_string(),
+    };
+    // SAFETY: the caller's guarantee on `error`.
+    unsafe { write_error(error, error_len, &message) };
+    std::ptr::null_mut()
+}
+
+/// Runs `body` on the handle under `catch_unwind`; NULL handle or panic:
+/// `EIGENMPC_STATUS_BAD_ARGUMENT`.
+///
+/// # Safety
+/// `mpc` is NULL or a live handle from [`eigenmpc_create`].
+unsafe fn with_handle(mpc: *mut EigenMpc, body: impl FnOnce(&mut EigenMpc) -> i32) -> i32 {
+    if mpc.is_null() {
+        return STATUS_BAD_ARGUMENT;
+    }
+    // SAFETY: non-null live handle (caller's guarantee), used one call at a time.
+    let handle = unsafe { &mut *mpc };
+    match catch_unwind(AssertUnwindSafe(|| body(&mut *handle))) {
+        Ok(code) => code,
+        Err(_) => handle.fail("internal error (panic caught)".into()),
+    }
+}
+
+/// Sets the reference energy E_ref (J) for the following steps. Returns 0,
+/// or `EIGENMPC_STATUS_BAD_ARGUMENT` (value refused, see [`eigenmpc_last_error`]).
+///
+/// # Safety
+/// `mpc` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn eigenmpc_set_e_ref(mpc: *mut EigenMpc, e_ref: f64) -> i32 {
+    // SAFETY: forwarded caller guarantee.
+    unsafe {
+        with_handle(mpc, |h| match h.controller.set_e_ref(e_ref) {
+            Ok(()) => 0,
+            Err(e) => h.fail(format!("eigenmpc_set_e_ref: {e}")),
+        })
+    }
+}
+
+/// Takes over the tunable fields of `config` (e_ref, alpha, beta, w_e, w_x,
+/// w_xd, w_f) for the following steps; the other fields are ignored. Returns
+/// 0, or `EIGENMPC_STATUS_BAD_ARGUMENT` (nothing changed).
+///
+/// # Safety
+/// `mpc` is NULL or a live handle; `config` is NULL or points to a config.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn eigenmpc_set_tuning(
+    mpc: *mut EigenMpc,
+    config: *const EigenMpcConfig,
+) -> i32 {
+    // SAFETY: forwarded caller guarantees.
+    unsafe {
+        with_handle(mpc, |h| {
+            if config.is_null() {
+                return h.fail("eigenmpc_set_tuning: config is NULL".into());
+            }
+            let cost = tuning_from(&*config).cost(h.variant);
+            match h.controller.set_cost(cost) {
+                Ok(()) => 0,
+                Err(e) => h.fail(format!("eigenmpc_set_tuning: {e}")),
+            }
+        })
+    }
+}
+
+/// One control sample: measured `state` = (q1, q2, qd1, qd2) in rad, rad/s;
+/// writes the torque to apply until the next sample to `tau_out` (N m,
+/// always finite and within +-tau_max). Returns the status:
+/// `EIGENMPC_STATUS_SOLVED` (0), `_NOT_CONVERGED` (1, first sample only),
+/// `_QP_FAILED` (2) or `_INVALID_STATE` (3) (both with the fallback torque),
+/// or `_BAD_ARGUMENT` (-1: NULL pointer; `tau_out` untouched). Call it every
+/// `sample_period` seconds.
+///
+/// # Safety
+/// `mpc` is NULL or a live handle; `state` is NULL or points to 4 doubles;
+/// `tau_out` is NULL or points to 2 writable doubles.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn eigenmpc_step(
+    mpc: *mut EigenMpc,
+    state: *const f64,
+    tau_out: *mut f64,
+) -> i32 {
+    // SAFETY: forwarded caller guarantees.
+    unsafe {
+        with_handle(mpc, |h| {
+            if state.is_null() || tau_out.is_null() {
+                return h.fail("eigenmpc_step: state or tau_out is NULL".into());
+            }
+            let z = SVector::<f64, 4>::from_column_slice(std::slice::from_raw_parts(state, 4));
+            let out: ControlOutput<2> = h.controller.step(&z);
+            *tau_out = out.tau[0];
+            *tau_out.add(1) = out.tau[1];
+            let energy = if matches!(out.status, ControlStatus::InvalidState) {
+                f64::NAN
+            } else {
+                h.controller.energy(&z)
+            };
+            h.info = EigenMpcStepInfo {
+                status: out.status.code(),
+                qp_iterations: u32::try_from(out.qp_iterations).unwrap_or(u32::MAX),
+                solve_time: out.preparation_time + out.feedback_time,
+                energy,
+            };
+            h.info.status
+        })
+    }
+}
+
+/// Diagnostics of the last [`eigenmpc_step`] (all zero before the first).
+/// Returns 0, or `EIGENMPC_STATUS_BAD_ARGUMENT` for a NULL pointer.
+///
+/// # Safety
+/// `mpc` is NULL or a live handle; `info` is NULL or points to a writable struct.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn eigenmpc_last_step(
+    mpc: *mut EigenMpc,
+    info: *mut EigenMpcStepInfo,
+) -> i32 {
+    // SAFETY: forwarded caller guarantees.
+    unsafe {
+        with_handle(mpc, |h| {
+            if info.is_null() {
+                return h.fail("eigenmpc_last_step: info is NULL".into());
+            }
+            *info = h.info;
+            0
+        })
+    }
+}
+
+/// Forgets the plan: the next step starts afresh (solved to convergence).
+/// Returns 0, or `EIGENMPC_STATUS_BAD_ARGUMENT` for a NULL handle.
+///
+/// # Safety
+/// `mpc` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn eigenmpc_reset(mpc: *mut EigenMpc) -> i32 {
+    // SAFETY: forwarded caller guarantee.
+    unsafe {
+        with_handle(mpc, |h| {
+            h.controller.reset();
+            0
+        })
+    }
+}
+
+/// Message of the last failed call on this handle ("" if none; a static
+/// message for a NULL handle). Valid until the next call on the handle.
+///
+/// # Safety
+/// `mpc` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn eigenmpc_last_error(mpc: *const EigenMpc) -> *const c_char {
+    if mpc.is_null() {
+        return c"the EigenMpc handle is NULL".as_ptr();
+    }
+    // SAFETY: non-null live handle.
+    unsafe { (*mpc).last_error.as_ptr() }
+}
+
+/// Frees a controller (NULL is ignored).
+///
+/// # Safety
+/// `mpc` is NULL or a live handle from [`eigenmpc_create`], not used afterwards.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn eigenmpc_free(mpc: *mut EigenMpc) {
+    if !mpc.is_null() {
+        // SAFETY: the handle came from Box::into_raw in eigenmpc_create.
+        let _ = catch_unwind(AssertUnwindSafe(|| drop(unsafe { Box::from_raw(mpc) })));
+    }
+}

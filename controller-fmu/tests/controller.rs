@@ -1,0 +1,498 @@
+//! The EigenMPC FMU through its FMI 2.0 C functions (sampling and hold,
+//! initialization, tunables, parameter checks), the plain C API's argument
+//! handling, the default chart, the checked-in model description and the
+//! built shared library.
+
+use eigenmpc::mechanics::{DoublePendulum, Vector};
+use eigenmpc::modes::{Chart, FMU_CHART_DEGREE, fmu_chart_coef_name};
+use eigenmpc::mpc::closed_loop::{mode_and_chart, run};
+use eigenmpc::mpc::{ControlStatus, Variant};
+use eigenmpc_fmu::capi::*;
+use eigenmpc_fmu::fmi2_exports::*;
+use eigenmpc_fmu::settings::{CHART_COEFFICIENTS, Settings};
+use eigenmpc_fmu::*;
+use fmi2_slave::testing::LogCapture;
+use fmi2_slave::{Model, Value, ffi, xml};
+use nalgebra::SVector;
+use std::ffi::{CStr, CString};
+use std::path::PathBuf;
+use std::ptr;
+
+const OK: ffi::fmi2Status = ffi::fmi2Status_fmi2OK;
+const WARNING: ffi::fmi2Status = ffi::fmi2Status_fmi2Warning;
+const ERROR: ffi::fmi2Status = ffi::fmi2Status_fmi2Error;
+const STATE: [u32; 4] = [VR_Q1, VR_Q2, VR_QD1, VR_QD2];
+
+struct Fmu {
+    c: ffi::fmi2Component,
+    log: Box<LogCapture>,
+    _callbacks: Box<ffi::fmi2CallbackFunctions>,
+    t: f64,
+}
+
+impl Fmu {
+    fn instantiate() -> Self {
+        let log = LogCapture::new();
+        let callbacks = Box::new(log.callbacks());
+        let name = CString::new("controller").unwrap();
+        let guid = CString::new(xml::guid(&EigenMpcFmu::description())).unwrap();
+        let c = unsafe {
+            fmi2Instantiate(
+                name.as_ptr(),
+                ffi::fmi2Type_fmi2CoSimulation,
+                guid.as_ptr(),
+                ptr::null(),
+                &*callbacks,
+                0,
+                0,
+            )
+        };
+        assert!(!c.is_null());
+        Self {
+            c,
+            log,
+            _callbacks: callbacks,
+            t: 0.0,
+        }
+    }
+
+    /// Instantiated, parameters and initial state set, initialized.
+    fn start(params: &[(u32, f64)], integers: &[(u32, i32)], z0: [f64; 4]) -> Self {
+        let fmu = Self::instantiate();
+        for &(vr, v) in params {
+            assert_eq!(fmu.set(&[vr], &[v]), OK, "{:?}", fmu.log.lines());
+        }
+        for &(vr, v) in integers {
+            assert_eq!(fmu.set_int(&[vr], &[v]), OK, "{:?}", fmu.log.lines());
+        }
+        unsafe {
+            assert_eq!(fmi2SetupExperiment(fmu.c, 0, 0.0, 0.0, 0, 0.0), OK);
+            assert_eq!(fmi2EnterInitializationMode(fmu.c), OK);
+            assert_eq!(fmu.set(&STATE, &z0), OK);
+            assert_eq!(
+                fmi2ExitInitializationMode(fmu.c),
+                OK,
+                "{:?}",
+                fmu.log.lines()
+            );
+        }
+        fmu
+    }
+
+    fn set(&self, vr: &[u32], v: &[f64]) -> ffi::fmi2Status {
+        unsafe { fmi2SetReal(self.c, vr.as_ptr(), vr.len(), v.as_ptr()) }
+    }
+
+    fn set_int(&self, vr: &[u32], v: &[i32]) -> ffi::fmi2Status {
+        unsafe { fmi2SetInteger(self.c, vr.as_ptr(), vr.len(), v.as_ptr()) }
+    }
+
+    fn tau(&self) -> [f64; 2] {
+        let mut v = [f64::NAN; 2];
+        let vr = [VR_TAU1, VR_TAU2];
+        assert_eq!(
+            unsafe { fmi2GetReal(self.c, vr.as_ptr(), 2, v.as_mut_ptr()) },
+            OK
+        );
+        v
+    }
+
+    fn real(&self, vr: u32) -> f64 {
+        let mut v = f64::NAN;
+        assert_eq!(unsafe { fmi2GetReal(self.c, &vr, 1, &mut v) }, OK);
+        v
+    }
+
+    fn integer(&self, vr: u32) -> i32 {
+        let mut v = -99;
+        assert_eq!(unsafe { fmi2GetInteger(self.c, &vr, 1, &mut v) }, OK);
+        v
+    }
+
+    fn step(&mut self, h: f64) -> ffi::fmi2Status {
+        let status = unsafe { fmi2DoStep(self.c, self.t, h, 1) };
+        self.t += h;
+        status
+    }
+}
+
+impl Drop for Fmu {
+    fn drop(&mut self) {
+        unsafe { fmi2FreeInstance(self.c) }
+    }
+}
+
+const Z0: [f64; 4] = [0.05, 0.05, 0.0, 0.0];
+const DT: f64 = 0.025;
+
+/// States and torques of a native closed loop of `seconds` (controller
+/// built from the same settings as the FMU's defaults).
+fn native_trace(seconds: f64) -> Vec<(SVector<f64, 4>, Vector<2>)> {
+    let mut controller = Settings::paper(Variant::Curved).build().unwrap();
+    let trace = run(
+        &mut controller,
+        &DoublePendulum::default(),
+        &SVector::<f64, 4>::from(Z0),
+        seconds,
+    )
+    .unwrap();
+    trace.iter().map(|s| (s.state, s.tau)).collect()
+}
+
+#[test]
+fn solves_on_the_sample_grid_and_holds_in_between() {
+    let native = native_trace(1.0);
+    // Communication step = sample period: one solve per step.
+    let mut fmu = Fmu::start(&[], &[], Z0);
+    assert_eq!(
+        fmu.tau(),
+        [native[0].1[0], native[0].1[1]],
+        "first solve at init"
+    );
+    assert_eq!(fmu.integer(VR_SOLVER_STATUS), 0);
+    assert!(fmu.integer(VR_QP_ITERATIONS) > 0);
+    for (k, (z, tau)) in native.iter().enumerate().take(native.len() - 1) {
+        assert_eq!(fmu.set(&STATE, z.as_slice()), OK);
+        assert_eq!(fmu.step(DT), OK, "{:?}", fmu.log.lines());
+        assert_eq!(fmu.tau(), [tau[0], tau[1]], "sample {k}");
+        let e = eigenmpc_fmu_energy(z);
+        assert!((fmu.real(VR_ENERGY) - e).abs() < 1e-12);
+        assert!(fmu.real(VR_SOLVE_TIME) > 0.0);
+    }
+    // Five communication steps per sample: solves only on the grid; the
+    // inputs between grid points do not matter.
+    let mut fmu = Fmu::start(&[], &[], Z0);
+    for (k, (z, tau)) in native.iter().enumerate().take(native.len() - 1) {
+        for i in 0..5 {
+            let decoy = z.map(|v| v + 0.3 * i as f64);
+            let input = if i == 0 { *z } else { decoy };
+            assert_eq!(fmu.set(&STATE, input.as_slice()), OK);
+            assert_eq!(fmu.step(DT / 5.0), OK);
+            assert_eq!(fmu.tau(), [tau[0], tau[1]], "sample {k}, substep {i}");
+        }
+    }
+    assert!(fmu.log.lines().iter().all(|l| l.status == OK));
+}
+
+fn eigenmpc_fmu_energy(z: &SVector<f64, 4>) -> f64 {
+    eigenmpc::mechanics::state_energy::<_, 2, 4>(&DoublePendulum::default(), z)
+}
+
+#[test]
+fn off_grid_and_long_steps_warn_once_and_keep_solving() {
+    // 10 ms steps: the grid points at 25, 75, ... ms fall inside steps.
+    let mut fmu = Fmu::start(&[], &[], Z0);
+    let mut statuses = vec![];
+    let mut changes = 0;
+    let mut last = fmu.tau();
+    for _ in 0..20 {
+        statuses.push(fmu.step(0.01));
+        if fmu.tau() != last {
+            changes += 1;
+            last = fmu.tau();
+        }
+    }
+    assert_eq!(statuses.iter().filter(|&&s| s == WARNING).count(), 1);
+    assert!(statuses.iter().all(|&s| s == OK || s == WARNING));
+    assert!(fmu.log.contains(&["not on the sample grid"]));
+    // solves at 0.03, 0.05, 0.08, 0.1, ...: 8 solves in 0.2 s (the state is
+    // held constant, so the torque changes as the plan evolves)
+    assert!((6..=8).contains(&changes), "{changes} torque changes");
+
+    let mut fmu = Fmu::start(&[], &[], Z0);
+    let mut warnings = 0;
+    let mut last = fmu.tau();
+    for k in 0..5 {
+        warnings += (fmu.step(0.1) == WARNING) as usize;
+        if k == 0 {
+            // t = 0 was solved at initialization
+            assert_eq!(fmu.tau(), last);
+        } else {
+            assert_ne!(fmu.tau(), last, "one solve per long step");
+        }
+        last = fmu.tau();
+    }
+    assert_eq!(warnings, 1);
+    assert!(fmu.log.contains(&["longer than the sample period"]));
+}
+
+#[test]
+fn new_initial_inputs_after_initialization_are_solved_again() {
+    let native = native_trace(0.05);
+    let mut fmu = Fmu::start(&[], &[], [0.3, -0.2, 0.0, 0.0]);
+    let first = fmu.tau();
+    assert_eq!(fmu.set(&STATE, &Z0), OK);
+    assert_eq!(fmu.step(DT), OK);
+    assert_ne!(fmu.tau(), first);
+    assert_eq!(fmu.tau(), [native[0].1[0], native[0].1[1]]);
+}
+
+#[test]
+fn tunable_parameters_are_followed_and_checked() {
+    let mut fmu = Fmu::start(&[], &[], Z0);
+    assert_eq!(fmu.step(DT), OK);
+    let model = |f: &Fmu| unsafe {
+        let instance = &*(f.c as *const fmi2_slave::Instance<EigenMpcFmu>);
+        instance.model().unwrap().controller().config().cost
+    };
+    assert_eq!(model(&fmu).e_ref, 14.0);
+    assert_eq!(model(&fmu).weights.energy, 25.0, "w_E < 0: paper value");
+    assert_eq!(fmu.set(&[VR_E_REF, VR_W_E], &[8.0, 7.5]), OK);
+    assert_eq!(model(&fmu).e_ref, 8.0);
+    assert_eq!(model(&fmu).weights.energy, 7.5);
+    assert_eq!(fmu.step(DT), OK);
+    // out of range: refused, nothing changes
+    assert_eq!(fmu.set(&[VR_E_REF, VR_W_F], &[9.0, 0.0]), ERROR);
+    assert!(fmu.log.contains(&["w_F = 0 is below its minimum"]));
+    assert_eq!(model(&fmu).e_ref, 8.0);
+
+    let mut fmu = Fmu::start(&[], &[], Z0);
+    assert_eq!(fmu.step(DT), OK);
+    assert_eq!(fmu.set(&[VR_TAU_MAX], &[2.0]), ERROR, "fixed in step mode");
+    assert!(
+        fmu.log
+            .contains(&["tau_max", "cannot be set in state stepComplete"])
+    );
+}
+
+#[test]
+fn invalid_parameters_are_rejected_with_a_message() {
+    for (vr, v, needle) in [
+        (VR_E_REF, -1.0, "E_ref = -1 is below its minimum"),
+        (
+            VR_SAMPLE_PERIOD,
+            0.0,
+            "sample_period = 0 is below its minimum",
+        ),
+        (VR_M1, f64::NAN, "m[1] = NaN is not a finite number"),
+        (VR_C1, 2.0, "c[1] = 2 is above its maximum"),
+        (VR_Q1, f64::INFINITY, "q[1] = inf is not a finite number"),
+    ] {
+        let fmu = Fmu::instantiate();
+        assert_eq!(fmu.set(&[vr], &[v]), ERROR);
+        assert!(fmu.log.contains(&[needle]), "{:?}", fmu.log.lines());
+    }
+    let fmu = Fmu::instantiate();
+    assert_eq!(fmu.set_int(&[VR_VARIANT], &[3]), ERROR);
+    assert!(fmu.log.contains(&["variant = 3 is above its maximum"]));
+    assert_eq!(unsafe { fmi2Reset(fmu.c) }, OK);
+    assert_eq!(fmu.set_int(&[VR_HORIZON], &[0]), ERROR);
+    // relations checked at exitInitializationMode
+    let fmu = Fmu::instantiate();
+    assert_eq!(fmu.set(&[VR_C1, VR_C2], &[0.0, 0.0]), OK);
+    unsafe {
+        assert_eq!(fmi2EnterInitializationMode(fmu.c), OK);
+        assert_eq!(fmi2ExitInitializationMode(fmu.c), ERROR);
+    }
+    assert!(
+        fmu.log
+            .contains(&["fmi2ExitInitializationMode", "eigenvector"])
+    );
+}
+
+#[test]
+fn straight_variant_uses_its_paper_weight() {
+    let fmu = Fmu::start(&[], &[(VR_VARIANT, VARIANT_STRAIGHT)], Z0);
+    let instance = unsafe { &*(fmu.c as *const fmi2_slave::Instance<EigenMpcFmu>) };
+    let controller = instance.model().unwrap().controller();
+    assert_eq!(controller.config().cost.weights.energy, 5.0);
+    assert_eq!(controller.reference().variant(), Variant::Straight);
+    let tau = fmu.tau();
+    assert!(tau[0].abs() <= 1.0 && tau[1].abs() <= 1.0 && tau != [0.0, 0.0]);
+}
+
+#[test]
+fn a_failed_solve_returns_the_fallback_with_its_status() {
+    // A state so fast that the prediction overflows: the QP data are not
+    // finite and the QP fails; the FMU logs and holds a bounded torque.
+    let mut fmu = Fmu::start(&[], &[], Z0);
+    assert_eq!(fmu.set(&STATE, &[0.1, 0.1, 1e155, -1e155]), OK);
+    let status = fmu.step(DT);
+    assert_eq!(status, WARNING, "{:?}", fmu.log.lines());
+    let code = fmu.integer(VR_SOLVER_STATUS);
+    assert_eq!(code, STATUS_QP_FAILED);
+    assert!(fmu.log.contains(&["QP failed"]));
+    let tau = fmu.tau();
+    assert!(tau.iter().all(|t| t.is_finite() && t.abs() <= 1.0));
+    // and the controller recovers on sane inputs
+    assert_eq!(fmu.set(&STATE, &Z0), OK);
+    fmu.step(DT);
+    assert!(fmu.tau().iter().all(|t| t.is_finite()));
+}
+
+#[test]
+fn status_codes_match_the_controller() {
+    assert_eq!(ControlStatus::Solved.code(), STATUS_SOLVED);
+    assert_eq!(ControlStatus::NotConverged.code(), STATUS_NOT_CONVERGED);
+    assert_eq!(ControlStatus::InvalidState.code(), STATUS_INVALID_STATE);
+    assert_eq!(
+        ControlStatus::QpFailed(eigenmpc::qp::QpStatus::MaxIterations).code(),
+        STATUS_QP_FAILED
+    );
+}
+
+#[test]
+fn default_chart_and_eigenvector_are_the_14_j_in_phase_mode() {
+    let system = DoublePendulum::default();
+    let (mode, chart) = mode_and_chart::<_, 2, 4>(&system, 0, 14.0, FMU_CHART_DEGREE).unwrap();
+    let d = EigenMpcFmu::description();
+    let start = |name: &str| match d.variable(name).unwrap().start {
+        Some(Value::Real(x)) => x,
+        other => panic!("{name}: {other:?}"),
+    };
+    let c = Vector::<2>::new(start("c[1]"), start("c[2]"));
+    assert!(
+        (c - chart.eigenvector).amax() < 1e-12,
+        "{c} vs {}",
+        chart.eigenvector
+    );
+    assert_eq!(start("E_ref"), 14.0);
+    let coefficients: [Vec<f64>; 2] = std::array::from_fn(|j| {
+        (0..CHART_COEFFICIENTS)
+            .map(|k| start(&fmu_chart_coef_name(j + 1, k)))
+            .collect()
+    });
+    // Coefficients agree to fitting noise (the even ones are ~1e-12 noise);
+    // the curve itself agrees to far below the fit residual over the mode.
+    for (fmu_row, fitted_row) in coefficients.iter().zip(&chart.coefficients) {
+        for (k, (a, b)) in fmu_row.iter().zip(fitted_row).enumerate() {
+            assert!(
+                (a - b).abs() < 1e-8 * (1.0 + b.abs()),
+                "power {k}: {a} vs {b}"
+            );
+        }
+    }
+    let pasted = Chart::from_coefficients(c, Vector::<2>::zeros(), coefficients).unwrap();
+    for q in &mode.path {
+        let s = chart.coordinate(q);
+        assert!((pasted.eval(s).x - chart.eval(s).x).amax() < 1e-9);
+    }
+}
+
+#[test]
+fn c_api_refuses_bad_arguments_without_crashing() {
+    unsafe {
+        let mut err = [0 as std::ffi::c_char; 200];
+        assert!(eigenmpc_create(ptr::null(), ptr::null(), err.as_mut_ptr(), 200).is_null());
+        assert!(
+            CStr::from_ptr(err.as_ptr())
+                .to_str()
+                .unwrap()
+                .contains("config is NULL")
+        );
+        let mut config = eigenmpc_config_default(VARIANT_CURVED);
+        config.horizon = 0;
+        assert!(eigenmpc_create(&config, ptr::null(), err.as_mut_ptr(), 200).is_null());
+        let text = CStr::from_ptr(err.as_ptr()).to_str().unwrap();
+        assert!(text.contains("horizon"), "{text}");
+        // a too small buffer is truncated, still NUL-terminated
+        assert!(eigenmpc_create(&config, ptr::null(), err.as_mut_ptr(), 8).is_null());
+        assert_eq!(CStr::from_ptr(err.as_ptr()).to_bytes().len(), 7);
+        let config = eigenmpc_config_default(7);
+        assert!(eigenmpc_create(&config, ptr::null(), ptr::null_mut(), 0).is_null());
+
+        let config = eigenmpc_config_default(VARIANT_CURVED);
+        let mpc = eigenmpc_create(&config, ptr::null(), ptr::null_mut(), 0);
+        assert!(!mpc.is_null());
+        let mut tau = [f64::NAN; 2];
+        assert_eq!(
+            eigenmpc_step(ptr::null_mut(), Z0.as_ptr(), tau.as_mut_ptr()),
+            -1
+        );
+        assert_eq!(eigenmpc_step(mpc, ptr::null(), tau.as_mut_ptr()), -1);
+        assert!(tau[0].is_nan(), "untouched");
+        assert_eq!(eigenmpc_set_e_ref(mpc, f64::NAN), -1);
+        let msg = CStr::from_ptr(eigenmpc_last_error(mpc)).to_str().unwrap();
+        assert!(msg.contains("e_ref"), "{msg}");
+        assert_eq!(
+            eigenmpc_step(mpc, Z0.as_ptr(), tau.as_mut_ptr()),
+            STATUS_SOLVED
+        );
+        let nan = [f64::NAN, 0.0, 0.0, 0.0];
+        assert_eq!(
+            eigenmpc_step(mpc, nan.as_ptr(), tau.as_mut_ptr()),
+            STATUS_INVALID_STATE
+        );
+        assert!(tau.iter().all(|t| t.is_finite() && t.abs() <= 1.0));
+        let mut info = EigenMpcStepInfo::default();
+        assert_eq!(eigenmpc_last_step(mpc, &mut info), 0);
+        assert_eq!(info.status, STATUS_INVALID_STATE);
+        assert_eq!(eigenmpc_reset(ptr::null_mut()), -1);
+        assert!(!eigenmpc_last_error(ptr::null()).is_null());
+        eigenmpc_free(mpc);
+        eigenmpc_free(ptr::null_mut());
+    }
+}
+
+#[test]
+fn c_api_steps_like_the_controller() {
+    let native = native_trace(0.5);
+    unsafe {
+        let config = eigenmpc_config_default(VARIANT_CURVED);
+        let mpc = eigenmpc_create(&config, ptr::null(), ptr::null_mut(), 0);
+        let mut tau = [0.0; 2];
+        for (z, t) in &native {
+            assert_eq!(eigenmpc_step(mpc, z.as_ptr(), tau.as_mut_ptr()), 0);
+            assert_eq!(tau, [t[0], t[1]]);
+        }
+        eigenmpc_free(mpc);
+    }
+}
+
+/// The cdylib cargo built for this test run (target/<profile>/deps).
+fn library() -> PathBuf {
+    let exe = std::env::current_exe().unwrap();
+    let lib = exe.parent().unwrap().join("libeigenmpc_fmu.so");
+    assert!(lib.exists(), "{} not built", lib.display());
+    lib
+}
+
+#[test]
+fn shared_library_exports_all_34_functions_and_the_c_api() {
+    let out = std::process::Command::new("nm")
+        .args(["-D", "--defined-only"])
+        .arg(library())
+        .output()
+        .expect("nm (binutils) is installed");
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    let exported: Vec<&str> = text
+        .lines()
+        .filter_map(|l| {
+            let f: Vec<&str> = l.split_whitespace().collect();
+            (f.len() == 3 && f[1] == "T").then_some(f[2])
+        })
+        .collect();
+    for name in fmi2_slave::FMI2_CS_FUNCTIONS {
+        assert!(exported.contains(&name), "{name} not exported");
+    }
+    let fmi: Vec<&&str> = exported.iter().filter(|s| s.starts_with("fmi2")).collect();
+    assert_eq!(fmi.len(), 34, "{fmi:?}");
+    for name in [
+        "eigenmpc_config_default",
+        "eigenmpc_create",
+        "eigenmpc_set_e_ref",
+        "eigenmpc_set_tuning",
+        "eigenmpc_step",
+        "eigenmpc_last_step",
+        "eigenmpc_reset",
+        "eigenmpc_last_error",
+        "eigenmpc_free",
+    ] {
+        assert!(exported.contains(&name), "{name} not exported");
+    }
+}
+
+#[test]
+fn checked_in_model_description_matches_the_table() {
+    let d = EigenMpcFmu::description();
+    d.validate().unwrap();
+    let generated = xml::model_description_xml(&d);
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../modelDescription/EigenMPC.xml");
+    let checked_in = std::fs::read_to_string(&path).unwrap_or_default();
+    assert!(
+        checked_in == generated,
+        "{} is out of date with the variable table: run `cargo run -p fmu-build` and commit it",
+        path.display()
+    );
+}
