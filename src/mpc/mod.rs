@@ -451,6 +451,8 @@ where
         let start = Instant::now();
         if self.shift_pending {
             self.shift();
+            self.solver
+                .shift_warm_start(self.solution.status.is_usable());
             self.shift_pending = false;
             self.prepared = false;
         }

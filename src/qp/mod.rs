@@ -242,4 +242,10 @@ pub trait QpSolver {
     /// Solves `qp` into `solution` (overwritten in place); returns the status
     /// that is also stored in `solution.status`. Never panics on bad data.
     fn solve(&mut self, qp: &OcpQp, solution: &mut QpSolution) -> QpStatus;
+    /// Tells the solver that the next QP is the last one shifted by one
+    /// stage (RTI), so it may start from the shifted previous solution;
+    /// `previous_usable` is false when the last solve failed. Default: ignored.
+    fn shift_warm_start(&mut self, previous_usable: bool) {
+        let _ = previous_usable;
+    }
 }
