@@ -432,6 +432,9 @@ fn warm_start_from_an_unrelated_solution_still_converges_to_the_same_point() {
         let du = (0..n)
             .map(|k| (&sol.u[k] - &cold.u[k]).amax())
             .fold(0.0, f64::max);
-        assert!(du < 1e-8, "({nx}, {nu}): warm vs cold controls differ by {du:e}");
+        assert!(
+            du < 1e-8,
+            "({nx}, {nu}): warm vs cold controls differ by {du:e}"
+        );
     }
 }
