@@ -6,7 +6,7 @@
 use eigenmpc::mechanics::DoublePendulum;
 use eigenmpc::modes::linear_modes;
 use eigenmpc::mpc::closed_loop::mode_and_chart;
-use eigenmpc::mpc::{Controller, MpcConfig, Reference};
+use eigenmpc::mpc::{Controller, MpcConfig, QpBackend, Reference};
 use eigenmpc::qp::clarabel::{ClarabelQpSolver, rti_settings};
 use eigenmpc::qp::{OcpQp, QpSolution, QpSolver, QpStatus};
 use nalgebra::SVector;
@@ -106,6 +106,28 @@ fn control_steps_do_not_allocate() {
         eprintln!(
             "{variant}: clarabel allocations per solve: {}",
             backend as f64 / (samples + 1) as f64
+        );
+
+        // The Riccati backend, built by `Controller::new` from the config:
+        // no allocation at all after the first sample. (Same test function:
+        // the counters are global, parallel tests would disturb them.)
+        config.qp = QpBackend::Riccati;
+        let mut ctrl = Controller::<_, 2, 4>::new(sys, config, ctrl.reference().clone()).unwrap();
+        let mut z = SVector::<f64, 4>::new(0.3, 0.2, 0.0, 0.0);
+        z = eigenmpc::integrate::rk4_step::<_, 2, 4>(&sys, &z, &ctrl.step(&z).tau, 0.025);
+        let before = OURS.load(Ordering::SeqCst) + BACKEND.load(Ordering::SeqCst);
+        for _ in 0..samples {
+            ctrl.prepare();
+            let out = ctrl.feedback(&z);
+            assert!(out.status.is_ok());
+            z = eigenmpc::integrate::rk4_step::<_, 2, 4>(&sys, &z, &out.tau, 0.025);
+        }
+        ctrl.set_e_ref(12.0).unwrap();
+        ctrl.step(&z);
+        let total = OURS.load(Ordering::SeqCst) + BACKEND.load(Ordering::SeqCst) - before;
+        assert_eq!(
+            total, 0,
+            "{variant}: riccati controller allocated {total} times"
         );
     }
 }

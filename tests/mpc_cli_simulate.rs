@@ -89,6 +89,7 @@ fn simulate_refuses_bad_input_with_a_message() {
         (vec!["simulate", "--x0", "1,2"], "--x0"),
         (vec!["simulate", "--dt", "-1", "--duration", "1"], "dt"),
         (vec!["simulate", "--energy", "nan"], "--energy"),
+        (vec!["simulate", "--qp", "hpipm"], "unknown QP backend"),
         (
             vec![
                 "simulate",
@@ -108,4 +109,58 @@ fn simulate_refuses_bad_input_with_a_message() {
         assert!(stderr.contains(needle), "{args:?}: {stderr}");
         assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
     }
+}
+
+#[test]
+fn simulate_qp_backends_agree() {
+    // The same 2 s closed loop with each QP backend: the energy columns of
+    // the CSVs agree (both QPs are solved well below 1e-6).
+    let dir = std::env::temp_dir().join(format!("eigenmpc-simqp-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut energies = Vec::new();
+    for qp in ["clarabel", "riccati"] {
+        let csv = dir.join(format!("{qp}.csv"));
+        let out = eigenmpc(&[
+            "simulate",
+            "--variant",
+            "straight",
+            "--energy",
+            "4",
+            "--duration",
+            "2",
+            "--N",
+            "40",
+            "--qp",
+            qp,
+            "--csv",
+            csv.to_str().unwrap(),
+        ]);
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success(),
+            "{stdout}{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(stdout.contains(&format!("QP {qp}")), "{stdout}");
+        let text = std::fs::read_to_string(&csv).unwrap();
+        let energy: Vec<f64> = text
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').nth(7).unwrap().parse().unwrap())
+            .collect();
+        assert_eq!(energy.len(), 81);
+        energies.push(energy);
+    }
+    let worst = energies[0]
+        .iter()
+        .zip(&energies[1])
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    // The controller pumps energy in, so the comparison is not of two idle runs.
+    assert!(energies[0][80] > 2.0 * energies[0][0], "{:?}", energies[0]);
+    assert!(
+        worst < 1e-4,
+        "clarabel vs riccati energy differ by {worst:e} J"
+    );
+    std::fs::remove_dir_all(&dir).ok();
 }

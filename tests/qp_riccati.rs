@@ -410,3 +410,31 @@ fn recorded_rti_set_matches_clarabel() {
         "recorded set: {n} QPs, max |du0| {u0:.1e}, max KKT {kkt:.1e}, max iterations {iters}"
     );
 }
+
+#[test]
+fn warm_start_from_an_unrelated_solution_still_converges_to_the_same_point() {
+    // The warm start only changes the starting point: after a solve of one
+    // QP and `shift_warm_start`, a different QP (bounds active, one core
+    // compile-time-sized, one runtime-sized) gives the cold solution.
+    let mut rng = SplitMix64::new(77);
+    for (nx, nu) in [(4, 2), (3, 1)] {
+        let n = 30;
+        let first = with_control_box(random_ocp_qp(&mut rng, nx, nu, n), 0.3);
+        let second = with_control_box(random_ocp_qp(&mut rng, nx, nu, n), 0.2);
+        let (cold, _) = solve(&second);
+        let mut solver = RiccatiSolver::new(nx, nu, n, RiccatiSettings::default());
+        let mut sol = QpSolution::new(nx, nu, n);
+        assert_eq!(solver.solve(&first, &mut sol), QpStatus::Solved);
+        solver.shift_warm_start(true);
+        assert_eq!(solver.solve(&second, &mut sol), QpStatus::Solved);
+        let reference = clarabel_solve(&second);
+        assert_matches(&format!("warm ({nx}, {nu})"), &second, &sol, &reference);
+        let du = (0..n)
+            .map(|k| (&sol.u[k] - &cold.u[k]).amax())
+            .fold(0.0, f64::max);
+        assert!(
+            du < 1e-8,
+            "({nx}, {nu}): warm vs cold controls differ by {du:e}"
+        );
+    }
+}

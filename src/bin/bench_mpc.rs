@@ -1,5 +1,6 @@
-//! Benchmark of the EigenMPC control step (issue 3): per-sample compute time
-//! in closed loop on the paper's 14 J scenarios, split into preparation
+//! Benchmark of the EigenMPC control step (issues 3 and 5), both QP backends
+//! side by side: per-sample compute time in closed loop on the paper's 14 J
+//! scenarios, split into preparation
 //! (shift + RK4 sensitivities + residual Jacobians + QP assembly) and
 //! feedback (QP solve and step), and its growth with the horizon N.
 //!
@@ -10,7 +11,7 @@
 use eigenmpc::mechanics::DoublePendulum;
 use eigenmpc::modes::linear_modes;
 use eigenmpc::mpc::closed_loop::{Sample, mode_and_chart, quantile, run};
-use eigenmpc::mpc::{Controller, MpcConfig, Reference, Variant};
+use eigenmpc::mpc::{Controller, MpcConfig, QpBackend, Reference, Variant};
 use nalgebra::SVector;
 
 fn stats(mut v: Vec<f64>) -> [f64; 4] {
@@ -33,7 +34,12 @@ fn ms(x: [f64; 4]) -> String {
     )
 }
 
-fn run_case(variant: Variant, horizon: usize, duration: f64) -> Vec<Sample<2, 4>> {
+fn run_case(
+    variant: Variant,
+    horizon: usize,
+    duration: f64,
+    backend: QpBackend,
+) -> Vec<Sample<2, 4>> {
     let sys = DoublePendulum::default();
     let reference = match variant {
         Variant::Straight => Reference::Straight {
@@ -46,6 +52,7 @@ fn run_case(variant: Variant, horizon: usize, duration: f64) -> Vec<Sample<2, 4>
     };
     let mut config = MpcConfig::paper(variant);
     config.horizon = horizon;
+    config.qp = backend;
     // Keep the simulated dynamics identical across N: same sample period.
     let mut ctrl = Controller::<_, 2, 4>::new(sys, config, reference).expect("controller");
     let z0 = SVector::<f64, 4>::new(0.05, 0.05, 0.0, 0.0);
@@ -66,55 +73,67 @@ fn main() {
             });
     }
     println!(
-        "## EigenMPC control step, N = 80, dt = 25 ms, {duration} s closed loop (clarabel QP)\n"
+        "## EigenMPC control step, N = 80, dt = 25 ms, {duration} s closed loop, both QP backends\n"
     );
-    println!("| scenario | phase | median ms | p95 ms | p99 ms | max ms | QP iter. median |");
-    println!("|---|---|---|---|---|---|---|");
+    println!(
+        "| scenario | QP | phase | median ms | p95 ms | p99 ms | max ms | QP iter. median / max |"
+    );
+    println!("|---|---|---|---|---|---|---|---|");
     for variant in [Variant::Curved, Variant::Straight] {
-        let trace = run_case(variant, 80, duration);
-        let rest = &trace[1..];
-        let prep: Vec<f64> = rest.iter().map(|s| s.preparation_time).collect();
-        let feedback: Vec<f64> = rest
-            .iter()
-            .map(|s| s.solve_time - s.preparation_time)
-            .collect();
-        let total: Vec<f64> = rest.iter().map(|s| s.solve_time).collect();
-        let mut iters: Vec<f64> = rest.iter().map(|s| s.qp_iterations as f64).collect();
-        iters.sort_by(f64::total_cmp);
-        let it = quantile(&iters, 0.5);
-        let name = format!("{variant} 14 J in-phase");
-        println!("| {name} | preparation | {} | |", ms(stats(prep)));
-        println!(
-            "| {name} | feedback (QP) | {} | {it:.0} |",
-            ms(stats(feedback))
-        );
-        println!("| {name} | total | {} | |", ms(stats(total)));
-        println!(
-            "| {name} | first sample (converged SQP, cold start) | {:.3} | | | | |",
-            trace[0].solve_time * 1e3
-        );
+        for backend in QpBackend::ALL {
+            let trace = run_case(variant, 80, duration, backend);
+            let rest = &trace[1..];
+            let prep: Vec<f64> = rest.iter().map(|s| s.preparation_time).collect();
+            let feedback: Vec<f64> = rest
+                .iter()
+                .map(|s| s.solve_time - s.preparation_time)
+                .collect();
+            let total: Vec<f64> = rest.iter().map(|s| s.solve_time).collect();
+            let iters = stats(rest.iter().map(|s| s.qp_iterations as f64).collect());
+            let failures = rest.iter().filter(|s| !s.status.is_ok()).count();
+            let name = format!("{variant} 14 J in-phase");
+            println!(
+                "| {name} | {backend} | preparation | {} | |",
+                ms(stats(prep))
+            );
+            println!(
+                "| {name} | {backend} | feedback (QP) | {} | {:.0} / {:.0} |",
+                ms(stats(feedback)),
+                iters[0],
+                iters[3]
+            );
+            println!("| {name} | {backend} | total | {} | |", ms(stats(total)));
+            println!(
+                "| {name} | {backend} | first sample (converged SQP, cold start) | {:.3} | | | | {failures} failed samples |",
+                trace[0].solve_time * 1e3
+            );
+        }
     }
     println!("\n## Growth with the horizon (curved 14 J, {duration} s closed loop)\n");
     println!(
-        "| N | total median ms | p95 | p99 | max | preparation median ms | feedback median ms | median per interval us |"
+        "| N | QP | total median ms | p95 | p99 | max | preparation median ms | feedback median ms | median per interval us | QP iter. median |"
     );
-    println!("|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|");
     for n in [20, 40, 80, 160, 320] {
-        let trace = run_case(Variant::Curved, n, duration);
-        let rest = &trace[1..];
-        let total = stats(rest.iter().map(|s| s.solve_time).collect());
-        let prep = stats(rest.iter().map(|s| s.preparation_time).collect());
-        let fb = stats(
-            rest.iter()
-                .map(|s| s.solve_time - s.preparation_time)
-                .collect(),
-        );
-        println!(
-            "| {n} | {} | {:.3} | {:.3} | {:.1} |",
-            ms(total),
-            prep[0] * 1e3,
-            fb[0] * 1e3,
-            total[0] * 1e6 / n as f64
-        );
+        for backend in QpBackend::ALL {
+            let trace = run_case(Variant::Curved, n, duration, backend);
+            let rest = &trace[1..];
+            let total = stats(rest.iter().map(|s| s.solve_time).collect());
+            let prep = stats(rest.iter().map(|s| s.preparation_time).collect());
+            let fb = stats(
+                rest.iter()
+                    .map(|s| s.solve_time - s.preparation_time)
+                    .collect(),
+            );
+            let iters = stats(rest.iter().map(|s| s.qp_iterations as f64).collect());
+            println!(
+                "| {n} | {backend} | {} | {:.3} | {:.3} | {:.1} | {:.0} |",
+                ms(total),
+                prep[0] * 1e3,
+                fb[0] * 1e3,
+                total[0] * 1e6 / n as f64,
+                iters[0]
+            );
+        }
     }
 }

@@ -7,7 +7,7 @@ use clap::Args;
 use eigenmpc::mechanics::Vector;
 use eigenmpc::modes::{Chart, Family, linear_modes};
 use eigenmpc::mpc::closed_loop::{Summary, mode_and_chart, run, summarise};
-use eigenmpc::mpc::{Controller, MpcConfig, Reference, Variant};
+use eigenmpc::mpc::{Controller, MpcConfig, QpBackend, Reference, Variant};
 use eigenmpc::report::{plot_run, summary_text, write_csv};
 use nalgebra::SVector;
 use std::path::{Path, PathBuf};
@@ -72,6 +72,9 @@ pub struct SimulateArgs {
     /// SQP iterations per sample (1 = RTI).
     #[arg(long, default_value_t = 1)]
     iterations: usize,
+    /// QP solver: `clarabel` (default) or `riccati` (structure-exploiting).
+    #[arg(long, default_value = "clarabel")]
+    qp: String,
     #[command(flatten)]
     model: ModelArgs,
 }
@@ -122,6 +125,7 @@ fn chart_from_json(path: &Path, energy: f64) -> anyhow::Result<Chart<2>> {
 pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
     let variant: Variant = args.variant.parse().map_err(anyhow::Error::msg)?;
     let family: Family = args.family.parse().map_err(anyhow::Error::msg)?;
+    let backend: QpBackend = args.qp.parse().map_err(anyhow::Error::msg)?;
     let x0 = super::parse_list("x0", &args.x0)?;
     if x0.len() != 4 || x0.iter().any(|v| !v.is_finite()) {
         bail!("--x0 needs 4 finite numbers q1,q2,qd1,qd2");
@@ -150,6 +154,7 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
     config.substeps = args.substeps;
     config.tau_max = args.tau_max;
     config.iterations_per_sample = args.iterations;
+    config.qp = backend;
     config.cost.e_ref = args.energy;
     config.cost.alpha = args.alpha;
     config.cost.beta = args.beta;
@@ -176,8 +181,13 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
 
 fn print_summary(args: &SimulateArgs, variant: Variant, family: Family, s: &Summary<2>) {
     println!(
-        "{variant} EigenMPC, {family}, E_ref = {} J, x0 = {}, {} s, N = {}, dt = {} s",
-        args.energy, args.x0, args.duration, args.horizon, args.dt
+        "{variant} EigenMPC, {family}, E_ref = {} J, x0 = {}, {} s, N = {}, dt = {} s, QP {}",
+        args.energy,
+        args.x0,
+        args.duration,
+        args.horizon,
+        args.dt,
+        args.qp.trim().to_ascii_lowercase()
     );
     print!("{}", summary_text(s));
 }

@@ -22,7 +22,7 @@ pub use cost::{CostParams, Reference, Variant, Weights};
 
 use crate::integrate::rk4_step_sensitivity;
 use crate::mechanics::{MechanicalSystem, Vector, state_energy};
-use crate::qp::clarabel::{ClarabelQpSolver, rti_settings};
+pub use crate::qp::QpBackend;
 use crate::qp::{OcpQp, QpSolution, QpSolver, QpStatus};
 use cost::{stage_cost, stage_model};
 use nalgebra::{SMatrix, SVector};
@@ -76,6 +76,8 @@ pub struct MpcConfig {
     pub converge_first_sample: bool,
     /// Converged-SQP settings.
     pub sqp: SqpOptions,
+    /// QP solver built by [`Controller::new`] (default clarabel, see docs/results.md).
+    pub qp: QpBackend,
 }
 
 impl MpcConfig {
@@ -102,6 +104,7 @@ impl MpcConfig {
             iterations_per_sample: 1,
             converge_first_sample: true,
             sqp: SqpOptions::default(),
+            qp: QpBackend::default(),
         }
     }
 
@@ -318,10 +321,12 @@ impl<S, const N: usize, const NX: usize> Controller<S, N, NX>
 where
     S: MechanicalSystem<N>,
 {
-    /// Builds the controller with the clarabel QP backend ([`rti_settings`]).
+    /// Builds the controller with the QP backend chosen by `config.qp`.
     pub fn new(system: S, config: MpcConfig, reference: Reference<N>) -> Result<Self, MpcError> {
-        let solver = ClarabelQpSolver::new(2 * N, N, config.horizon, rti_settings());
-        Self::with_solver(system, config, reference, Box::new(solver))
+        // Validate before sizing the solver: a bad horizon must not allocate.
+        config.validate()?;
+        let solver = config.qp.create(2 * N, N, config.horizon);
+        Self::with_solver(system, config, reference, solver)
     }
 
     /// Builds the controller with a given QP backend (sized for `2N`, `N`, `config.horizon`).
@@ -459,6 +464,8 @@ where
         let start = Instant::now();
         if self.shift_pending {
             self.shift();
+            self.solver
+                .shift_warm_start(self.solution.status.is_usable());
             self.shift_pending = false;
             self.prepared = false;
         }

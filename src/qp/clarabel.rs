@@ -37,9 +37,13 @@ pub fn rti_settings() -> DefaultSettings<f64> {
 }
 
 /// Settings for reference solves (tests, converged SQP): tight tolerances
-/// with iterative refinement, still reusable.
+/// with iterative refinement and equilibration, still reusable (data updates
+/// reapply the first QP's equilibration). Without equilibration the RTI QPs'
+/// costates (|pi| ~ 1e3) leave complementarity at ~1e-9 and the first control
+/// off by up to 5e-6 on weakly active torque bounds.
 pub fn accurate_settings() -> DefaultSettings<f64> {
     DefaultSettings {
+        equilibrate_enable: true,
         tol_gap_abs: 1e-10,
         tol_gap_rel: 1e-10,
         tol_feas: 1e-10,

@@ -170,6 +170,70 @@ impl QpSolution {
     }
 }
 
+/// Which [`QpSolver`] the controller builds: the general-purpose clarabel
+/// (the reference, and the default until the Riccati solver meets all of
+/// issue 5's acceptance criteria) or the structure-exploiting [`RiccatiSolver`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum QpBackend {
+    /// [`clarabel::ClarabelQpSolver`] with [`clarabel::rti_settings`].
+    #[default]
+    Clarabel,
+    /// [`RiccatiSolver`] with [`RiccatiSettings::default`].
+    Riccati,
+}
+
+impl QpBackend {
+    /// Both backends, in table order.
+    pub const ALL: [QpBackend; 2] = [QpBackend::Clarabel, QpBackend::Riccati];
+
+    /// Name used by the CLI, FMU parameters and logs (`clarabel`, `riccati`).
+    pub fn name(self) -> &'static str {
+        match self {
+            QpBackend::Clarabel => "clarabel",
+            QpBackend::Riccati => "riccati",
+        }
+    }
+
+    /// Creates the solver for QPs with `nx` states, `nu` controls and
+    /// horizon `horizon` (allocates; call once at set-up).
+    pub fn create(self, nx: usize, nu: usize, horizon: usize) -> Box<dyn QpSolver + Send> {
+        match self {
+            QpBackend::Clarabel => Box::new(self::clarabel::ClarabelQpSolver::new(
+                nx,
+                nu,
+                horizon,
+                self::clarabel::rti_settings(),
+            )),
+            QpBackend::Riccati => Box::new(RiccatiSolver::new(
+                nx,
+                nu,
+                horizon,
+                RiccatiSettings::default(),
+            )),
+        }
+    }
+}
+
+impl std::fmt::Display for QpBackend {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for QpBackend {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "clarabel" => Ok(QpBackend::Clarabel),
+            "riccati" => Ok(QpBackend::Riccati),
+            other => Err(format!(
+                "unknown QP backend `{other}` (expected `clarabel` or `riccati`)"
+            )),
+        }
+    }
+}
+
 /// A solver for [`OcpQp`]s of fixed dimensions, created once and reused at
 /// every sample (its symbolic set-up is done at creation).
 pub trait QpSolver {
@@ -178,4 +242,10 @@ pub trait QpSolver {
     /// Solves `qp` into `solution` (overwritten in place); returns the status
     /// that is also stored in `solution.status`. Never panics on bad data.
     fn solve(&mut self, qp: &OcpQp, solution: &mut QpSolution) -> QpStatus;
+    /// Tells the solver that the next QP is the last one shifted by one
+    /// stage (RTI), so it may start from the shifted previous solution;
+    /// `previous_usable` is false when the last solve failed. Default: ignored.
+    fn shift_warm_start(&mut self, previous_usable: bool) {
+        let _ = previous_usable;
+    }
 }

@@ -215,6 +215,8 @@ pub(super) struct FixedCore<const NX: usize, const NU: usize, const M: usize> {
     ratio: f64,
     set: RiccatiSettings,
     pub(super) info: RiccatiInfo,
+    /// Start the next solve from the shifted previous multipliers.
+    pub(super) warm: bool,
 }
 
 impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
@@ -230,6 +232,7 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
             ratio: f64::INFINITY,
             set: RiccatiSettings::default(),
             info: RiccatiInfo::default(),
+            warm: false,
         }
     }
 
@@ -384,10 +387,23 @@ impl<const NX: usize, const NU: usize, const M: usize> Core for FixedCore<NX, NU
             lam0 = lam0.max(st.ql.amax()).max(st.rl.amax());
         }
         lam0 *= self.set.initial_multiplier;
+        let warm = self.warm;
+        let floor = self.set.warm_start_floor;
+        if warm {
+            // RTI: the new QP is the previous one shifted by one stage; the
+            // last stage keeps its multipliers. The primal start stays the
+            // plain one (in step variables the shifted solution is ~0).
+            for k in 0..n {
+                self.st[k].pi = self.st[k + 1].pi;
+                self.st[k].lam = self.st[k + 1].lam;
+            }
+        }
         self.st[0].x = self.x0;
         for k in 0..=n {
             let st = &mut self.st[k];
-            st.pi = Vecn::zeros();
+            if !warm {
+                st.pi = Vecn::zeros();
+            }
             st.sl = Vecn::zeros();
             st.u = Vecn::zeros();
             if k < n {
@@ -423,7 +439,10 @@ impl<const NX: usize, const NU: usize, const M: usize> Core for FixedCore<NX, NU
             }
             let cv = st.constraint_values();
             for i in 0..M {
-                if st.mask[i] > 0.0 {
+                if st.mask[i] > 0.0 && warm {
+                    st.t[i] = cv[i].max(floor);
+                    st.lam[i] = st.lam[i].max(floor);
+                } else if st.mask[i] > 0.0 {
                     st.t[i] = cv[i].max(t0);
                     st.lam[i] = lam0 / st.t[i];
                 } else {

@@ -69,6 +69,16 @@ pub struct RiccatiSettings {
     /// iterations and no stalls on long horizons with unstable
     /// linearisations; `false` keeps the plain start.
     pub mehrotra_start: bool,
+    /// After [`QpSolver::shift_warm_start`] (the controller calls it at each
+    /// RTI shift), start from the shifted previous dynamics and bound
+    /// multipliers instead of the cold multipliers. Measured on the paper's
+    /// closed loops at N = 80: median iterations 12 -> 7 (curved) and
+    /// 10 -> 6 (straight), see docs/results.md.
+    pub warm_start: bool,
+    /// Floor of the warm-started slacks and multipliers: the previous
+    /// solution sits on the boundary (products ~1e-11), where the Newton
+    /// steps would be cut to nothing; 1e-2 measured best of 1e-1..1e-4.
+    pub warm_start_floor: f64,
 }
 
 impl Default for RiccatiSettings {
@@ -86,6 +96,8 @@ impl Default for RiccatiSettings {
             initial_multiplier: 1.0,
             tol_stationarity_relative: 1e-14,
             mehrotra_start: true,
+            warm_start: true,
+            warm_start_floor: 1e-2,
         }
     }
 }
@@ -252,6 +264,8 @@ pub struct RiccatiSolver {
     info: RiccatiInfo,
     total_regularised: u64,
     engine: Engine,
+    /// The next solve starts from the shifted last iterate.
+    warm_next: bool,
 }
 
 /// The core for the solver's dimensions: compile-time-sized for the 1-, 2-
@@ -275,6 +289,7 @@ impl RiccatiSolver {
             settings,
             info: RiccatiInfo::default(),
             total_regularised: 0,
+            warm_next: false,
             engine: match (nx, nu) {
                 (2, 1) => Engine::Joints1(Box::new(FixedCore::new(horizon))),
                 (4, 2) => Engine::Joints2(Box::new(FixedCore::new(horizon))),
@@ -312,19 +327,23 @@ impl RiccatiSolver {
                     n: self.horizon,
                     d: Runtime { nx, nu },
                     info: RiccatiInfo::default(),
+                    warm: self.warm_next,
                 };
                 (interior_point(&mut core, set, sol), core.info)
             }
             Engine::Joints1(core) => {
                 core.load(qp, set);
+                core.warm = self.warm_next;
                 (interior_point(&mut **core, set, sol), core.info)
             }
             Engine::Joints2(core) => {
                 core.load(qp, set);
+                core.warm = self.warm_next;
                 (interior_point(&mut **core, set, sol), core.info)
             }
             Engine::Joints3(core) => {
                 core.load(qp, set);
+                core.warm = self.warm_next;
                 (interior_point(&mut **core, set, sol), core.info)
             }
         };
@@ -339,6 +358,13 @@ impl QpSolver for RiccatiSolver {
         "riccati"
     }
 
+    fn shift_warm_start(&mut self, previous_usable: bool) {
+        let floor = self.settings.warm_start_floor;
+        // A floor that is not positive would start on the boundary.
+        self.warm_next =
+            previous_usable && self.settings.warm_start && floor.is_finite() && floor > 0.0;
+    }
+
     fn solve(&mut self, qp: &OcpQp, solution: &mut QpSolution) -> QpStatus {
         self.info = RiccatiInfo::default();
         let status = if !valid_dimensions(qp, self.nx, self.nu, self.horizon)
@@ -349,6 +375,7 @@ impl QpSolver for RiccatiSolver {
         } else {
             self.run(qp, solution)
         };
+        self.warm_next = false;
         solution.status = status;
         if status == QpStatus::InvalidInput {
             solution.iterations = 0;
@@ -454,6 +481,8 @@ struct Ipm<'a> {
     n: usize,
     d: Runtime,
     info: RiccatiInfo,
+    /// Start from the shifted last multipliers.
+    warm: bool,
 }
 
 /// Slot offsets inside a stage's inequality block.
@@ -722,7 +751,14 @@ impl Ipm<'_> {
         ws.on.fill(false);
         ws.soft.fill(false);
         ws.s.fill(0.0);
-        ws.pi.fill(0.0);
+        let (warm, floor) = (self.warm, self.set.warm_start_floor);
+        if warm {
+            // RTI: the new QP is the previous one shifted by one stage.
+            ws.pi.copy_within(nx.., 0);
+            ws.lam.copy_within(m.., 0);
+        } else {
+            ws.pi.fill(0.0);
+        }
         ws.x[..nx].copy_from_slice(qp.x0.as_slice());
         for k in 0..n {
             let (lb, ub) = (qp.u_lower[k].as_slice(), qp.u_upper[k].as_slice());
@@ -780,7 +816,10 @@ impl Ipm<'_> {
         for k in 0..=n {
             for i in 0..m {
                 let idx = k * m + i;
-                if ws.on[idx] {
+                if ws.on[idx] && warm {
+                    ws.t[idx] = constraint_value(d, qp, ws, k, i).max(floor);
+                    ws.lam[idx] = ws.lam[idx].max(floor);
+                } else if ws.on[idx] {
                     let c = constraint_value(d, qp, ws, k, i);
                     ws.t[idx] = c.max(t0);
                     ws.lam[idx] = lam0 / ws.t[idx];
