@@ -32,6 +32,12 @@ cargo test --workspace
 echo "== fmu-build (release cdylibs, target/fmu/*.fmu, include/eigenmpc.h)"
 cargo run -p fmu-build
 
+echo "== demo (the main job, on the FMUs just built): controller FMU drives plant FMU"
+cargo run --release -q -p eigenmpc-demo -- --no-build --out-dir target/demo-ci
+for f in demo.csv demo.png demo.svg; do
+    test -s "target/demo-ci/$f" || { echo "demo did not write target/demo-ci/$f" >&2; exit 1; }
+done
+
 echo "== C host tests (gcc, include/eigenmpc.h, linked FMU libraries)"
 target_dir=${CARGO_TARGET_DIR:-target}
 guid=$(grep -o 'guid="[^"]*"' modelDescription/DoublePendulum.xml | cut -d'"' -f2)
