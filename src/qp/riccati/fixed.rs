@@ -169,9 +169,12 @@ impl<const NX: usize, const NU: usize, const M: usize> Stage<NX, NU, M> {
 
     /// Slack and multiplier directions of the inequalities from `dx`, `du`
     /// (and `gs`); returns the smallest ratio `-v / dv` over decreasing
-    /// slacks and multipliers (infinite when none decreases).
+    /// slacks and multipliers, accumulated per slot into `decrease` (the
+    /// largest relative decrease `-dv / v`; its inverse is the ratio).
+    /// Per-slot accumulators keep the maximum from being one serial chain
+    /// of dependent comparisons over the whole horizon.
     #[inline(always)]
-    fn recover(&mut self) -> f64 {
+    fn recover(&mut self, decrease: &mut [f64; M]) {
         let inv_hss = self.inv_hss;
         let mut dc = [0.0; M];
         for j in 0..NU {
@@ -188,16 +191,16 @@ impl<const NX: usize, const NU: usize, const M: usize> Stage<NX, NU, M> {
             dc[2 * NU + NX + i] = (-self.coef_u[i] * dx - gs) * h;
             dc[2 * NU + 2 * NX + i] = ds;
         }
-        // Largest relative decrease -dv / v; its inverse is the ratio.
-        let mut decrease = 0.0f64;
         for i in 0..M {
             let dt = self.mask[i] * (dc[i] + self.rp[i]);
             let dlam = -(self.rc[i] + self.lam[i] * dt) * self.inv_t[i];
             self.dt[i] = dt;
             self.dlam[i] = dlam;
-            decrease = fmax(fmax(decrease, -dt * self.inv_t[i]), -dlam * self.inv_lam[i]);
+            decrease[i] = fmax(
+                fmax(decrease[i], -dt * self.inv_t[i]),
+                -dlam * self.inv_lam[i],
+            );
         }
-        1.0 / decrease
     }
 }
 
@@ -332,8 +335,12 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
                     }
                 }
             }
+            // sqrt(d) and 1/d issue in parallel (1/sqrt(d) would chain the
+            // division after the square root): the factorisation is a serial
+            // chain over pivots and stages, bound by their latency.
+            let inv_d = 1.0 / djj;
             let ljj = djj.sqrt();
-            let r = 1.0 / ljj;
+            let r = ljj * inv_d;
             m[(j, j)] = ljj;
             // The factor is used as a full matrix: clear the upper triangle.
             for c in j + 1..D {
@@ -366,10 +373,25 @@ fn nan_probe(v: f64) -> f64 {
     v * 0.0
 }
 
-/// `L (L' v)` for a lower-triangular `L` (the cost-to-go Hessian times `v`).
+/// `L (L' v) + p` for a lower-triangular `L` (the cost-to-go Hessian times
+/// `v`, plus `p`); full-range loops over the zero upper triangle unroll.
 #[inline(always)]
-fn llt_mul<const NX: usize>(l: &Mat<NX, NX>, v: &Vecn<NX>) -> Vecn<NX> {
-    l * l.tr_mul(v)
+fn llt_mul<const NX: usize>(l: &Mat<NX, NX>, v: &Vecn<NX>, p: &Vecn<NX>) -> Vecn<NX> {
+    let mut w = Vecn::<NX>::zeros();
+    for c in 0..NX {
+        let mut s = 0.0;
+        for i in 0..NX {
+            s += l[(i, c)] * v[i];
+        }
+        w[c] = s;
+    }
+    let mut out = *p;
+    for i in 0..NX {
+        for c in 0..NX {
+            out[i] += l[(i, c)] * w[c];
+        }
+    }
+    out
 }
 
 impl<const NX: usize, const NU: usize, const M: usize> Core for FixedCore<NX, NU, M> {
@@ -455,8 +477,13 @@ impl<const NX: usize, const NU: usize, const M: usize> Core for FixedCore<NX, NU
 
     fn residuals(&mut self) -> Residuals {
         let n = self.n;
-        let (mut stat, mut scale, mut feas) = (0.0f64, 0.0f64, 0.0f64);
-        let (mut gap, mut comp, mut probe) = (0.0, 0.0f64, 0.0);
+        // Per-component accumulators (maxima, sums and NaN probes): the
+        // reductions are independent chains instead of one long chain of
+        // dependent operations over the horizon.
+        let (mut stat_u, mut scale_u, mut probe_u) = ([0.0f64; NU], [0.0f64; NU], [0.0; NU]);
+        let (mut stat_x, mut scale_x, mut probe_x) = ([0.0f64; NX], [0.0f64; NX], [0.0; NX]);
+        let (mut feas_x, mut probe_e) = ([0.0f64; NX], [0.0; NX]);
+        let (mut feas, mut gap, mut comp) = ([0.0f64; M], [0.0; M], [0.0f64; M]);
         let (l1, l2) = (self.l1, self.l2);
         for k in 0..=n {
             let pi_prev = if k > 0 {
@@ -477,15 +504,15 @@ impl<const NX: usize, const NU: usize, const M: usize> Core for FixedCore<NX, NU
                 for j in 0..NU {
                     let v = st.rl[j] + h[j] + e[j] - ll[j] + lu[j];
                     let terms = fmax(fmax(st.rl[j].abs(), h[j].abs()), e[j].abs());
-                    scale = fmax(scale, fmax(terms, fmax(ll[j], lu[j])));
+                    scale_u[j] = fmax(scale_u[j], fmax(terms, fmax(ll[j], lu[j])));
                     st.ru[j] = v;
-                    stat = fmax(stat, v.abs());
-                    probe += nan_probe(v);
+                    stat_u[j] = fmax(stat_u[j], v.abs());
+                    probe_u[j] += nan_probe(v);
                 }
                 st.re = st.a * st.x + st.b * st.u + st.c - x_next;
                 for i in 0..NX {
-                    feas = fmax(feas, st.re[i].abs());
-                    probe += nan_probe(st.re[i]);
+                    feas_x[i] = fmax(feas_x[i], st.re[i].abs());
+                    probe_e[i] += nan_probe(st.re[i]);
                 }
             }
             if k >= 1 {
@@ -501,30 +528,37 @@ impl<const NX: usize, const NU: usize, const M: usize> Core for FixedCore<NX, NU
                     let prev = pi_prev[i];
                     let v = st.ql[i] + h[i] + e[i] - prev - xl[i] + xu[i];
                     let terms = fmax(fmax(st.ql[i].abs(), h[i].abs()), e[i].abs());
-                    scale = fmax(scale, fmax(fmax(terms, prev.abs()), fmax(xl[i], xu[i])));
+                    scale_x[i] = fmax(
+                        scale_x[i],
+                        fmax(fmax(terms, prev.abs()), fmax(xl[i], xu[i])),
+                    );
                     st.rx[i] = v;
                     let w = st.soft[i] * (l1[i] + l2[i] * st.sl[i] - xl[i] - xu[i] - xs[i]);
                     st.rs[i] = w;
-                    stat = fmax(stat, fmax(v.abs(), w.abs()));
-                    probe += nan_probe(v) + nan_probe(w);
+                    stat_x[i] = fmax(stat_x[i], fmax(v.abs(), w.abs()));
+                    probe_x[i] += nan_probe(v) + nan_probe(w);
                 }
             }
             let cv = st.constraint_values();
             for i in 0..M {
                 let r = st.mask[i] * (cv[i] - st.t[i]);
                 st.rp[i] = r;
-                feas = fmax(feas, r.abs());
+                feas[i] = fmax(feas[i], r.abs());
                 let tl = st.t[i] * st.lam[i];
-                gap += tl;
-                comp = fmax(comp, tl);
+                gap[i] += tl;
+                comp[i] = fmax(comp[i], tl);
             }
         }
+        let max = |v: &[f64]| v.iter().fold(0.0, |a, &b| fmax(a, b));
+        let sum = |v: &[f64]| v.iter().sum::<f64>();
+        let probe = sum(&probe_u) + sum(&probe_x) + sum(&probe_e);
+        let gap = sum(&gap);
         Residuals {
             // NaN anywhere makes the residual NaN (the iteration stops).
-            stationarity: stat + probe,
-            scale,
-            feasibility: feas,
-            complementarity: comp,
+            stationarity: fmax(max(&stat_u), max(&stat_x)) + probe,
+            scale: fmax(max(&scale_u), max(&scale_x)),
+            feasibility: fmax(max(&feas_x), max(&feas)),
+            complementarity: max(&comp),
             mu: if self.m_on > 0 {
                 gap / self.m_on as f64
             } else {
@@ -547,10 +581,14 @@ impl<const NX: usize, const NU: usize, const M: usize> Core for FixedCore<NX, NU
             let st = &mut self.st[k];
             let mut sig = [0.0; M];
             for i in 0..M {
-                let on = st.mask[i] > 0.0;
-                st.inv_t[i] = if on { 1.0 / st.t[i] } else { 0.0 };
-                st.inv_lam[i] = if on { 1.0 / st.lam[i] } else { 0.0 };
-                sig[i] = st.lam[i] * st.inv_t[i];
+                // One division per slot: 1/t = lam/(t lam), 1/lam = t/(t lam)
+                // (divisions bound the throughput of this loop); absent slots
+                // (t = 1, lam = 0, mask 0) get 0.
+                let (t, lam, on) = (st.t[i], st.lam[i], st.mask[i]);
+                let inv_tl = on / (t * lam + (1.0 - on));
+                st.inv_t[i] = lam * inv_tl;
+                st.inv_lam[i] = t * inv_tl;
+                sig[i] = lam * st.inv_t[i];
             }
             for j in 0..NU {
                 st.diag_u[j] = sig[j] + sig[NU + j];
@@ -589,21 +627,63 @@ impl<const NX: usize, const NU: usize, const M: usize> Core for FixedCore<NX, NU
                 st.lxx = mxx;
                 continue;
             }
-            // M = [R S; S' Q] + diag + [B A]' L L' [B A]; at k = 0 only the
-            // control block is needed (x_0 is fixed).
-            let bl = st.b.tr_mul(&lnext);
-            let mut muu = st.r + bl * bl.transpose();
+            // M = [R S; S' Q] + diag + W'W with W = L' [B A], written as
+            // full-range fixed loops (the upper triangle of L is zero): a
+            // triangular loop nest does not unroll and costs more than the
+            // multiplications by zero it saves. At k = 0 only the control
+            // block is needed (x_0 is fixed).
+            let mut wb = Mat::<NX, NU>::zeros();
+            let mut wa = Mat::<NX, NX>::zeros();
+            for i in 0..NX {
+                for r in 0..NX {
+                    let l = lnext[(r, i)];
+                    for j in 0..NU {
+                        wb[(i, j)] += l * st.b[(r, j)];
+                    }
+                }
+            }
+            let mut muu = st.r;
             for j in 0..NU {
+                for c in 0..NU {
+                    let mut v = muu[(j, c)];
+                    for i in 0..NX {
+                        v += wb[(i, j)] * wb[(i, c)];
+                    }
+                    muu[(j, c)] = v;
+                }
                 muu[(j, j)] += st.diag_u[j];
             }
             let du = muu.diagonal();
             let (mut mxx, mut mxu, dx) = if k > 0 {
-                let al = st.a.tr_mul(&lnext);
-                let mut mxx = st.q + al * al.transpose();
                 for i in 0..NX {
-                    mxx[(i, i)] += st.diag_x[i];
+                    for r in 0..NX {
+                        let l = lnext[(r, i)];
+                        for j in 0..NX {
+                            wa[(i, j)] += l * st.a[(r, j)];
+                        }
+                    }
                 }
-                let mxu = st.s.transpose() + al * bl.transpose();
+                let mut mxx = st.q;
+                for j in 0..NX {
+                    for c in 0..NX {
+                        let mut v = mxx[(j, c)];
+                        for i in 0..NX {
+                            v += wa[(i, j)] * wa[(i, c)];
+                        }
+                        mxx[(j, c)] = v;
+                    }
+                    mxx[(j, j)] += st.diag_x[j];
+                }
+                let mut mxu = Mat::<NX, NU>::zeros();
+                for j in 0..NU {
+                    for i in 0..NX {
+                        let mut v = st.s[(j, i)];
+                        for r in 0..NX {
+                            v += wa[(r, i)] * wb[(r, j)];
+                        }
+                        mxu[(i, j)] = v;
+                    }
+                }
                 let dx = mxx.diagonal();
                 (mxx, mxu, dx)
             } else {
@@ -638,7 +718,15 @@ impl<const NX: usize, const NU: usize, const M: usize> Core for FixedCore<NX, NU
                         mxu[(i, j)] *= r;
                     }
                 }
-                mxx -= mxu * mxu.transpose();
+                for j in 0..NX {
+                    for c in 0..NX {
+                        let mut v = mxx[(j, c)];
+                        for i in 0..NU {
+                            v -= mxu[(j, i)] * mxu[(c, i)];
+                        }
+                        mxx[(j, c)] = v;
+                    }
+                }
                 truncated += Self::cholesky(&mut mxx, &mut inv_x, &dx, None, set.pivot_tolerance);
                 st.lxu = mxu;
                 st.lxx = mxx;
@@ -686,24 +774,35 @@ impl<const NX: usize, const NU: usize, const M: usize> Core for FixedCore<NX, NU
             if k == n {
                 st.p = st.gx;
             } else {
-                let v = llt_mul(&l_next, &st.re) + p_next;
-                let g = st.gu + st.b.tr_mul(&v);
+                let v = llt_mul(&l_next, &st.re, &p_next);
                 for j in 0..NU {
-                    let mut y = g[j];
+                    let mut y = st.gu[j];
+                    for i in 0..NX {
+                        y += st.b[(i, j)] * v[i];
+                    }
                     for c in 0..j {
                         y -= st.luu[(j, c)] * st.yu[c];
                     }
                     st.yu[j] = y * st.inv_u[j];
                 }
                 if k > 0 {
-                    st.p = st.gx + st.a.tr_mul(&v) - st.lxu * st.yu;
+                    for i in 0..NX {
+                        let mut p = st.gx[i];
+                        for r in 0..NX {
+                            p += st.a[(r, i)] * v[r];
+                        }
+                        for j in 0..NU {
+                            p -= st.lxu[(i, j)] * st.yu[j];
+                        }
+                        st.p[i] = p;
+                    }
                 }
             }
             p_next = st.p;
             l_next = st.lxx;
         }
         // Forward sweep with the recovery of the inequality directions.
-        let mut ratio = f64::INFINITY;
+        let mut decrease = [0.0f64; M];
         let mut dx = Vecn::<NX>::zeros();
         for k in 0..=n {
             let (head, tail) = self.st.split_at_mut(k + 1);
@@ -711,21 +810,36 @@ impl<const NX: usize, const NU: usize, const M: usize> Core for FixedCore<NX, NU
             st.dx = dx;
             if k < n {
                 // du = -Luu^{-T} (Lxu' dx + yu)
-                let rhs = st.lxu.tr_mul(&dx) + st.yu;
                 for j in (0..NU).rev() {
-                    let mut v = rhs[j];
+                    let mut v = st.yu[j];
+                    for i in 0..NX {
+                        v += st.lxu[(i, j)] * dx[i];
+                    }
                     for c in j + 1..NU {
                         v += st.luu[(c, j)] * st.du[c];
                     }
                     st.du[j] = -v * st.inv_u[j];
                 }
-                dx = st.a * dx + st.b * st.du + st.re;
+                let mut dn = st.re;
+                for j in 0..NX {
+                    let d = dx[j];
+                    for i in 0..NX {
+                        dn[i] += st.a[(i, j)] * d;
+                    }
+                }
+                for j in 0..NU {
+                    let d = st.du[j];
+                    for i in 0..NX {
+                        dn[i] += st.b[(i, j)] * d;
+                    }
+                }
+                dx = dn;
                 let next = &tail[0];
-                st.dpi = llt_mul(&next.lxx, &dx) + next.p;
+                st.dpi = llt_mul(&next.lxx, &dx, &next.p);
             }
-            ratio = ratio.min(st.recover());
+            st.recover(&mut decrease);
         }
-        self.ratio = ratio;
+        self.ratio = 1.0 / decrease.iter().fold(0.0, |a, &d| fmax(a, d));
     }
 
     fn max_step(&self, fraction: f64) -> f64 {
@@ -733,13 +847,14 @@ impl<const NX: usize, const NU: usize, const M: usize> Core for FixedCore<NX, NU
     }
 
     fn gap_after(&self, alpha: f64) -> f64 {
-        let mut gap = 0.0;
+        // One partial sum per slot: independent chains instead of one.
+        let mut gap = [0.0; M];
         for st in &self.st {
             for i in 0..M {
-                gap += (st.t[i] + alpha * st.dt[i]) * (st.lam[i] + alpha * st.dlam[i]);
+                gap[i] += (st.t[i] + alpha * st.dt[i]) * (st.lam[i] + alpha * st.dlam[i]);
             }
         }
-        gap
+        gap.iter().sum()
     }
 
     fn take_step(&mut self, alpha: f64) {
