@@ -58,6 +58,8 @@ pub struct EigenMpcConfig {
     pub gravity: f64,
     /// Linear eigenvector c (normalised by the controller).
     pub eigenvector: [f64; 2],
+    /// QP solver: `EIGENMPC_QP_SOLVER_CLARABEL` (1) or `EIGENMPC_QP_SOLVER_RICCATI` (2, default).
+    pub qp_solver: i32,
 }
 
 /// Diagnostics of the last [`eigenmpc_step`].
@@ -103,6 +105,7 @@ fn settings_from(config: &EigenMpcConfig) -> Result<Settings, String> {
     };
     Ok(Settings {
         variant,
+        qp: crate::qp_backend(config.qp_solver)?,
         tuning: tuning_from(config),
         tau_max: config.tau_max,
         horizon: config.horizon as usize,
@@ -170,6 +173,7 @@ pub extern "C" fn eigenmpc_config_default(variant: i32) -> EigenMpcConfig {
         lengths: s.model.lengths,
         gravity: s.model.gravity,
         eigenvector: s.eigenvector,
+        qp_solver: crate::qp_solver_item(s.qp),
     }
 }
 

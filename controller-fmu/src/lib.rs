@@ -20,7 +20,7 @@ pub mod settings;
 
 use eigenmpc::mechanics::PlanarChainParams;
 use eigenmpc::modes::fmu_chart_coef_name;
-use eigenmpc::mpc::{ControlOutput, MpcConfig, Variant};
+use eigenmpc::mpc::{ControlOutput, MpcConfig, QpBackend, Variant};
 use fmi2_slave::{
     Context, DefaultExperiment, EnumerationType, Model, ModelDescription, ModelError, Unit, Value,
     Values, Variable,
@@ -90,6 +90,32 @@ pub const VR_SOLVER_STATUS: u32 = 1;
 pub const VR_VARIANT: u32 = 2;
 /// Integer value reference of parameter `horizon`.
 pub const VR_HORIZON: u32 = 3;
+/// Integer value reference of parameter `qp_solver` (`QP_SOLVER_*`).
+pub const VR_QP_SOLVER: u32 = 4;
+
+/// `qp_solver`: clarabel, the general-purpose interior-point reference.
+pub const QP_SOLVER_CLARABEL: i32 = 1;
+/// `qp_solver`: the structure-exploiting Riccati interior point (default).
+pub const QP_SOLVER_RICCATI: i32 = 2;
+
+/// The `qp_solver` item of a backend.
+pub fn qp_solver_item(backend: QpBackend) -> i32 {
+    match backend {
+        QpBackend::Clarabel => QP_SOLVER_CLARABEL,
+        QpBackend::Riccati => QP_SOLVER_RICCATI,
+    }
+}
+
+/// The backend of a `qp_solver` item.
+pub fn qp_backend(item: i32) -> Result<QpBackend, String> {
+    match item {
+        QP_SOLVER_CLARABEL => Ok(QpBackend::Clarabel),
+        QP_SOLVER_RICCATI => Ok(QpBackend::Riccati),
+        v => Err(format!(
+            "qp_solver = {v} is not an item of QpSolver (1 clarabel, 2 riccati)"
+        )),
+    }
+}
 
 /// `variant`: straight EigenMPC (distance to the linear eigenvector).
 pub const VARIANT_STRAIGHT: i32 = 1;
@@ -212,6 +238,7 @@ fn settings(values: &Values) -> Result<Settings, String> {
     }
     Ok(Settings {
         variant,
+        qp: qp_backend(values.integer(VR_QP_SOLVER))?,
         tuning: tuning(values),
         tau_max: values.real(VR_TAU_MAX),
         horizon: values.integer(VR_HORIZON) as usize,
@@ -474,8 +501,13 @@ impl Model for EigenMpcFmu {
                 );
             }
         }
-        // Reserved: `qp_solver` (enumeration Clarabel / Riccati) once the
-        // controller's MpcConfig offers the backend choice.
+        variables.push(
+            Variable::enumeration("qp_solver", VR_QP_SOLVER, "QpSolver")
+                .parameter(Value::Integer(qp_solver_item(QpBackend::default())))
+                .min(QP_SOLVER_CLARABEL as f64)
+                .max(QP_SOLVER_RICCATI as f64)
+                .describe("QP solver of the real-time iteration: riccati (structure-exploiting) or clarabel"),
+        );
         ModelDescription {
             model_name: "EigenMPC".into(),
             model_identifier: "EigenMPC".into(),
@@ -492,21 +524,39 @@ impl Model for EigenMpcFmu {
                 step_size: curved.dt,
             }),
             units: units(),
-            enumerations: vec![EnumerationType {
-                name: "Variant".into(),
-                items: vec![
-                    (
-                        "straight".into(),
-                        VARIANT_STRAIGHT,
-                        "Distance to the linear eigenvector line".into(),
-                    ),
-                    (
-                        "curved".into(),
-                        VARIANT_CURVED,
-                        "Distance to the eigenmode chart X(s)".into(),
-                    ),
-                ],
-            }],
+            enumerations: vec![
+                EnumerationType {
+                    name: "Variant".into(),
+                    items: vec![
+                        (
+                            "straight".into(),
+                            VARIANT_STRAIGHT,
+                            "Distance to the linear eigenvector line".into(),
+                        ),
+                        (
+                            "curved".into(),
+                            VARIANT_CURVED,
+                            "Distance to the eigenmode chart X(s)".into(),
+                        ),
+                    ],
+                },
+                EnumerationType {
+                    name: "QpSolver".into(),
+                    items: vec![
+                        (
+                            "clarabel".into(),
+                            QP_SOLVER_CLARABEL,
+                            "clarabel: general-purpose interior point (reference)".into(),
+                        ),
+                        (
+                            "riccati".into(),
+                            QP_SOLVER_RICCATI,
+                            "Riccati-recursion interior point exploiting the stage structure"
+                                .into(),
+                        ),
+                    ],
+                },
+            ],
             variables,
         }
     }

@@ -4,7 +4,7 @@
 
 use eigenmpc::mechanics::{DoublePendulum, PlanarChainParams, Vector};
 use eigenmpc::modes::{Chart, FMU_CHART_DEGREE};
-use eigenmpc::mpc::{Controller, CostParams, MpcConfig, Reference, Variant, Weights};
+use eigenmpc::mpc::{Controller, CostParams, MpcConfig, QpBackend, Reference, Variant, Weights};
 
 /// Number of chart coefficients per joint (powers `0..=9`, the library's
 /// `FMU_CHART_DEGREE`; a literal so that the C header can use it).
@@ -118,6 +118,8 @@ impl Tuning {
 pub struct Settings {
     /// Straight or curved EigenMPC.
     pub variant: Variant,
+    /// QP solver of the real-time iteration.
+    pub qp: QpBackend,
     /// Tunable cost parameters.
     pub tuning: Tuning,
     /// Torque bound `|tau_i| <= tau_max` (N m).
@@ -140,6 +142,7 @@ impl Settings {
         let config = MpcConfig::paper(variant);
         Self {
             variant,
+            qp: config.qp,
             tuning: Tuning::paper(),
             tau_max: config.tau_max,
             horizon: config.horizon,
@@ -157,8 +160,7 @@ impl Settings {
         config.dt = self.sample_period;
         config.tau_max = self.tau_max;
         config.cost = self.tuning.cost(self.variant);
-        // Reserved: the QP backend choice (`qp_solver`) goes here once
-        // `MpcConfig` carries one; until then the controller uses clarabel.
+        config.qp = self.qp;
         config
     }
 
