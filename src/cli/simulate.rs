@@ -72,8 +72,8 @@ pub struct SimulateArgs {
     /// SQP iterations per sample (1 = RTI).
     #[arg(long, default_value_t = 1)]
     iterations: usize,
-    /// QP solver: `clarabel` (default) or `riccati` (structure-exploiting).
-    #[arg(long, default_value = "clarabel")]
+    /// QP solver: `riccati` (structure-exploiting, default) or `clarabel` (reference).
+    #[arg(long, default_value_t = QpBackend::default().to_string())]
     qp: String,
     #[command(flatten)]
     model: ModelArgs,
