@@ -109,3 +109,42 @@ impl LogCapture {
         }
     }
 }
+
+/// The cdylib `lib<name>.so` cargo built for the running test: it sits next
+/// to the test executable in `target/<profile>/deps` (`cargo test` does not
+/// copy it up to `target/<profile>`).
+pub fn test_cdylib(name: &str) -> std::path::PathBuf {
+    let exe = std::env::current_exe().expect("test executable path");
+    let lib = exe
+        .parent()
+        .expect("test executable directory")
+        .join(format!("lib{name}.so"));
+    assert!(lib.exists(), "{} not built", lib.display());
+    lib
+}
+
+/// Asserts that `library` exports all 34 FMI 2.0 common + co-simulation
+/// functions and no other `fmi2*` symbol; returns every exported function
+/// name (`nm -D --defined-only`, text symbols) for further checks.
+pub fn assert_exports_fmi2_cs(library: &std::path::Path) -> Vec<String> {
+    let out = std::process::Command::new("nm")
+        .args(["-D", "--defined-only"])
+        .arg(library)
+        .output()
+        .expect("nm (binutils) is installed");
+    assert!(out.status.success(), "nm failed on {}", library.display());
+    let text = String::from_utf8_lossy(&out.stdout);
+    let exported: Vec<String> = text
+        .lines()
+        .filter_map(|l| {
+            let f: Vec<&str> = l.split_whitespace().collect();
+            (f.len() == 3 && f[1] == "T").then(|| f[2].to_string())
+        })
+        .collect();
+    for name in crate::FMI2_CS_FUNCTIONS {
+        assert!(exported.iter().any(|e| e == name), "{name} not exported");
+    }
+    let fmi: Vec<&String> = exported.iter().filter(|s| s.starts_with("fmi2")).collect();
+    assert_eq!(fmi.len(), 34, "{fmi:?}");
+    exported
+}

@@ -236,36 +236,14 @@ fn invalid_parameters_and_inputs_are_rejected() {
     );
 }
 
-/// The cdylib cargo built for this test run: next to the test executable in
-/// target/<profile>/deps (`cargo test` does not copy it up to target/<profile>).
+/// The plant's cdylib built for this test run.
 fn library() -> PathBuf {
-    let exe = std::env::current_exe().unwrap();
-    let lib = exe.parent().unwrap().join("libdouble_pendulum_fmu.so");
-    assert!(lib.exists(), "{} not built", lib.display());
-    lib
+    fmi2_slave::testing::test_cdylib("double_pendulum_fmu")
 }
 
 #[test]
 fn shared_library_exports_all_34_functions() {
-    let out = std::process::Command::new("nm")
-        .args(["-D", "--defined-only"])
-        .arg(library())
-        .output()
-        .expect("nm (binutils) is installed");
-    assert!(out.status.success());
-    let text = String::from_utf8_lossy(&out.stdout);
-    let exported: Vec<&str> = text
-        .lines()
-        .filter_map(|l| {
-            let f: Vec<&str> = l.split_whitespace().collect();
-            (f.len() == 3 && f[1] == "T").then_some(f[2])
-        })
-        .collect();
-    for name in fmi2_slave::FMI2_CS_FUNCTIONS {
-        assert!(exported.contains(&name), "{name} not exported");
-    }
-    let fmi: Vec<&&str> = exported.iter().filter(|s| s.starts_with("fmi2")).collect();
-    assert_eq!(fmi.len(), 34, "{fmi:?}");
+    fmi2_slave::testing::assert_exports_fmi2_cs(&library());
 }
 
 #[test]
