@@ -282,6 +282,83 @@ fn failures_return_the_shifted_plan_clipped() {
     assert_eq!(out.status.code(), 2);
 }
 
+/// A backend that fails for the first `failures` solves, then delegates.
+struct FailingFirst {
+    failures: usize,
+    inner: Box<dyn QpSolver + Send>,
+}
+impl QpSolver for FailingFirst {
+    fn name(&self) -> &'static str {
+        "failing-first"
+    }
+    fn solve(&mut self, qp: &OcpQp, sol: &mut QpSolution) -> QpStatus {
+        if self.failures > 0 {
+            self.failures -= 1;
+            sol.status = QpStatus::NumericalError;
+            return QpStatus::NumericalError;
+        }
+        self.inner.solve(qp, sol)
+    }
+}
+
+#[test]
+fn repeated_qp_failures_discard_the_plan_and_the_controller_recovers() {
+    let sys = DoublePendulum::default();
+    let mut config = MpcConfig::paper(Variant::Curved);
+    config.horizon = 40;
+    let z = Z::new(0.3, 0.1, 0.0, 0.0);
+    let reference_tau = Controller::<_, 2, 4>::new(sys, config, curved())
+        .unwrap()
+        .step(&z)
+        .tau;
+    // First sample solved, then MAX_QP_FAILURES failures in a row.
+    let inner = eigenmpc::mpc::QpBackend::default().create(4, 2, config.horizon);
+    let solver = FailingFirst { failures: 0, inner };
+    let mut ctrl =
+        Controller::<_, 2, 4>::with_solver(sys, config, curved(), Box::new(solver)).unwrap();
+    assert!(ctrl.step(&z).status.is_ok());
+    let mut failing = Controller::<_, 2, 4>::with_solver(
+        sys,
+        config,
+        curved(),
+        Box::new(FailingFirst {
+            failures: eigenmpc::mpc::MAX_QP_FAILURES,
+            inner: eigenmpc::mpc::QpBackend::default().create(4, 2, config.horizon),
+        }),
+    )
+    .unwrap();
+    for _ in 0..eigenmpc::mpc::MAX_QP_FAILURES {
+        let out = failing.step(&z);
+        assert!(
+            matches!(out.status, ControlStatus::QpFailed(_)),
+            "{:?}",
+            out.status
+        );
+        assert!(out.tau.iter().all(|t| t.is_finite() && t.abs() <= 1.0));
+    }
+    // The plan was discarded: the next sample starts afresh from the measured
+    // state, solved to convergence, exactly like a fresh controller.
+    let out = failing.step(&z);
+    assert_eq!(out.status, ControlStatus::Solved);
+    assert!(
+        out.sqp_iterations > 1,
+        "converged SQP, not a single RTI step"
+    );
+    assert!(
+        (out.tau - reference_tau).amax() < 1e-6,
+        "{} vs {}",
+        out.tau,
+        reference_tau
+    );
+    // A non-finite plan is discarded at the first failure: a huge speed drives
+    // the RK4 rollout to overflow and the QP data to NaN.
+    let wild = Z::new(0.3, 0.1, 1e200, -1e200);
+    let out = ctrl.step(&wild);
+    assert!(!out.status.is_ok(), "{:?}", out.status);
+    let out = ctrl.step(&z);
+    assert!(out.status.is_ok(), "recovered: {:?}", out.status);
+}
+
 #[test]
 fn bad_configuration_and_tuning_are_refused() {
     let sys = DoublePendulum::default();

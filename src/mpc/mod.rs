@@ -76,7 +76,7 @@ pub struct MpcConfig {
     pub converge_first_sample: bool,
     /// Converged-SQP settings.
     pub sqp: SqpOptions,
-    /// QP solver built by [`Controller::new`] (default clarabel, see docs/results.md).
+    /// QP solver built by [`Controller::new`] (default riccati, see docs/results.md).
     pub qp: QpBackend,
 }
 
@@ -311,11 +311,20 @@ pub struct Controller<S, const N: usize, const NX: usize> {
     prepared: bool,
     /// The plan was applied for one sample and must be shifted.
     shift_pending: bool,
-    /// L1 merit penalty parameter (grows monotonically).
+    /// L1 merit penalty parameter (grows monotonically until a reset).
     merit_penalty: f64,
     /// Preparation time already spent for the coming sample.
     pending_preparation_time: f64,
+    /// The last sample's QP solution may seed the next one (warm start).
+    warm_start_usable: bool,
+    /// QP failures in a row; the plan is rebuilt after [`MAX_QP_FAILURES`].
+    consecutive_qp_failures: usize,
 }
+
+/// QP failures in a row after which the plan is discarded and the next
+/// sample starts afresh (zero-torque rollout, converged SQP): a plan that
+/// made the QPs fail once is likely to keep doing so.
+pub const MAX_QP_FAILURES: usize = 2;
 
 impl<S, const N: usize, const NX: usize> Controller<S, N, NX>
 where
@@ -363,6 +372,8 @@ where
             shift_pending: false,
             merit_penalty: 1.0,
             pending_preparation_time: 0.0,
+            warm_start_usable: false,
+            consecutive_qp_failures: 0,
         })
     }
 
@@ -447,6 +458,9 @@ where
         self.prepared = false;
         self.shift_pending = false;
         self.pending_preparation_time = 0.0;
+        self.merit_penalty = 1.0;
+        self.warm_start_usable = false;
+        self.consecutive_qp_failures = 0;
     }
 
     /// One control step: preparation (unless already done) and feedback.
@@ -464,8 +478,7 @@ where
         let start = Instant::now();
         if self.shift_pending {
             self.shift();
-            self.solver
-                .shift_warm_start(self.solution.status.is_usable());
+            self.solver.shift_warm_start(self.warm_start_usable);
             self.shift_pending = false;
             self.prepared = false;
         }
@@ -495,6 +508,23 @@ where
         if self.initialised {
             self.shift_pending = true;
         }
+        // Only a solved sample seeds the next QP; after a fallback the
+        // solver's stored iterate no longer matches the shifted plan.
+        self.warm_start_usable = out.status.is_ok();
+        match out.status {
+            ControlStatus::QpFailed(_) => {
+                self.consecutive_qp_failures += 1;
+                let plan_finite = self.xs.iter().all(|x| x.iter().all(|v| v.is_finite()))
+                    && self.us.iter().all(|u| u.iter().all(|v| v.is_finite()));
+                if !plan_finite || self.consecutive_qp_failures >= MAX_QP_FAILURES {
+                    self.reset();
+                }
+            }
+            ControlStatus::Solved | ControlStatus::NotConverged => {
+                self.consecutive_qp_failures = 0;
+            }
+            ControlStatus::InvalidState => {}
+        }
         out.preparation_time = preparation_time;
         out.feedback_time = start.elapsed().as_secs_f64();
         out
@@ -522,6 +552,10 @@ where
             }
             let step = self.line_search(z);
             self.prepared = false;
+            if step.1 == 0.0 {
+                // No step length decreased the merit: stop rather than creep.
+                return self.output(ControlStatus::NotConverged, qp_iterations, it + 1);
+            }
             if step.1 == 1.0 && step.0 < self.config.sqp.tolerance {
                 return self.output(ControlStatus::Solved, qp_iterations, it + 1);
             }
@@ -761,8 +795,9 @@ where
         p
     }
 
-    /// Backtracking on the L1 merit along the QP step; applies the step and
-    /// returns (step infinity norm, accepted step length).
+    /// Backtracking on the L1 merit along the QP step; applies the accepted
+    /// step and returns (step infinity norm, accepted step length), the
+    /// length 0 when no tested length decreased the merit (nothing applied).
     fn line_search(&mut self, z: &SVector<f64, NX>) -> (f64, f64) {
         let nh = self.config.horizon;
         let mut max_pi: f64 = 0.0;
@@ -801,6 +836,7 @@ where
 
         let base = self.merit(&self.xs, &self.us, z, mu);
         let mut alpha = 1.0;
+        let mut accepted = false;
         while alpha > 1e-4 {
             for k in 0..=nh {
                 let mut x = self.xs[k];
@@ -817,10 +853,17 @@ where
                 }
             }
             let trial = self.merit(&self.xs_trial, &self.us_trial, z, mu);
-            if trial <= base + 1e-4 * alpha * slope.min(0.0) || step_norm < 1e-12 {
+            // Armijo on the merit, with room for round-off in its evaluation
+            // (near the solution the decrease is below the noise).
+            let noise = 1e-12 * base.abs().max(1.0);
+            if trial <= base + 1e-4 * alpha * slope.min(0.0) + noise || step_norm < 1e-12 {
+                accepted = true;
                 break;
             }
             alpha *= 0.5;
+        }
+        if !accepted {
+            return (step_norm, 0.0);
         }
         self.apply_step(alpha);
         (step_norm, alpha)
