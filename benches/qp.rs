@@ -23,7 +23,8 @@ struct Stats {
 
 fn stats(mut t: Vec<f64>) -> Stats {
     t.sort_by(f64::total_cmp);
-    let q = |p: f64| t[((t.len() - 1) as f64 * p).round() as usize];
+    // The same quantile definition as the closed-loop tables (nearest rank).
+    let q = |p: f64| eigenmpc::mpc::closed_loop::quantile(&t, p);
     Stats {
         median: q(0.5),
         p95: q(0.95),

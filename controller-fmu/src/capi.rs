@@ -16,7 +16,7 @@
 //! A handle may be used from any thread, one call at a time.
 
 use crate::settings::{CHART_COEFFICIENTS, PendulumController, Settings, Tuning};
-use crate::{STATUS_BAD_ARGUMENT, VARIANT_CURVED, VARIANT_STRAIGHT};
+use crate::STATUS_BAD_ARGUMENT;
 use eigenmpc::mechanics::PlanarChainParams;
 use eigenmpc::mpc::{ControlOutput, ControlStatus, Variant};
 use nalgebra::SVector;
@@ -46,7 +46,7 @@ pub struct EigenMpcConfig {
     pub w_f: f64,
     /// Torque bound |tau_j| <= tau_max (N m), > 0.
     pub tau_max: f64,
-    /// Shooting intervals N of the horizon, 1..=10000.
+    /// Shooting intervals N of the horizon, 1..=1000 (`eigenmpc::mpc::MAX_HORIZON`).
     pub horizon: u32,
     /// Sample period and shooting interval (s), > 0.
     pub sample_period: f64,
@@ -94,15 +94,7 @@ impl EigenMpc {
 }
 
 fn settings_from(config: &EigenMpcConfig) -> Result<Settings, String> {
-    let variant = match config.variant {
-        VARIANT_STRAIGHT => Variant::Straight,
-        VARIANT_CURVED => Variant::Curved,
-        v => {
-            return Err(format!(
-                "variant = {v}: expected EIGENMPC_VARIANT_STRAIGHT (1) or EIGENMPC_VARIANT_CURVED (2)"
-            ));
-        }
-    };
+    let variant = crate::variant_from_item(config.variant)?;
     Ok(Settings {
         variant,
         qp: crate::qp_backend(config.qp_solver)?,

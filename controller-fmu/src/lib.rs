@@ -106,6 +106,17 @@ pub fn qp_solver_item(backend: QpBackend) -> i32 {
     }
 }
 
+/// The variant of a `variant` item (FMU parameter and C API).
+pub fn variant_from_item(item: i32) -> Result<Variant, String> {
+    match item {
+        VARIANT_STRAIGHT => Ok(Variant::Straight),
+        VARIANT_CURVED => Ok(Variant::Curved),
+        v => Err(format!(
+            "variant = {v} is not an item of Variant (1 straight, 2 curved)"
+        )),
+    }
+}
+
 /// The backend of a `qp_solver` item.
 pub fn qp_backend(item: i32) -> Result<QpBackend, String> {
     match item {
@@ -221,15 +232,7 @@ fn tuning(values: &Values) -> Tuning {
 
 /// The controller settings held in the FMU's parameters.
 fn settings(values: &Values) -> Result<Settings, String> {
-    let variant = match values.integer(VR_VARIANT) {
-        VARIANT_STRAIGHT => Variant::Straight,
-        VARIANT_CURVED => Variant::Curved,
-        v => {
-            return Err(format!(
-                "variant = {v} is not an item of Variant (1 straight, 2 curved)"
-            ));
-        }
-    };
+    let variant = variant_from_item(values.integer(VR_VARIANT))?;
     let mut chart = [[0.0; CHART_COEFFICIENTS]; 2];
     for (j, row) in chart.iter_mut().enumerate() {
         for (k, a) in row.iter_mut().enumerate() {
@@ -433,7 +436,7 @@ impl Model for EigenMpcFmu {
             Variable::integer("horizon", VR_HORIZON)
                 .parameter(Value::Integer(curved.horizon as i32))
                 .min(1.0)
-                .max(1000.0)
+                .max(eigenmpc::mpc::MAX_HORIZON as f64)
                 .describe("Shooting intervals N of the prediction horizon"),
         );
         variables.push(

@@ -117,8 +117,8 @@ impl MpcConfig {
                 reason,
             })
         };
-        if self.horizon == 0 || self.horizon > 10_000 {
-            return bad("horizon", self.horizon as f64, "must be in 1..=10000");
+        if self.horizon == 0 || self.horizon > MAX_HORIZON {
+            return bad("horizon", self.horizon as f64, "must be in 1..=1000");
         }
         if !(self.dt.is_finite() && self.dt > 0.0) {
             return bad("dt", self.dt, "must be finite and > 0");
@@ -320,6 +320,10 @@ pub struct Controller<S, const N: usize, const NX: usize> {
     /// QP failures in a row; the plan is rebuilt after [`MAX_QP_FAILURES`].
     consecutive_qp_failures: usize,
 }
+
+/// Largest accepted horizon `N` (the FMU's `horizon` parameter and the C
+/// API share it; memory and time grow linearly in `N`).
+pub const MAX_HORIZON: usize = 1000;
 
 /// QP failures in a row after which the plan is discarded and the next
 /// sample starts afresh (zero-torque rollout, converged SQP): a plan that
