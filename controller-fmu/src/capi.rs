@@ -15,8 +15,8 @@
 //! return value (NULL, a negative status) and a message, never an abort.
 //! A handle may be used from any thread, one call at a time.
 
-use crate::settings::{CHART_COEFFICIENTS, PendulumController, Settings, Tuning};
 use crate::STATUS_BAD_ARGUMENT;
+use crate::settings::{CHART_COEFFICIENTS, PendulumController, Settings, Tuning};
 use eigenmpc::mechanics::PlanarChainParams;
 use eigenmpc::mpc::{ControlOutput, ControlStatus, Variant};
 use nalgebra::SVector;

@@ -178,15 +178,46 @@ impl Settings {
         let c = c.normalize();
         let reference = match self.variant {
             Variant::Straight => Reference::Straight { eigenvector: c },
-            Variant::Curved => Reference::Curved(
-                Chart::from_coefficients(
+            Variant::Curved => {
+                let chart = Chart::from_coefficients(
                     c,
                     eigenmpc::mechanics::MechanicalSystem::equilibrium(&system),
                     self.chart.map(|row| row.to_vec()),
                 )
-                .map_err(|e| format!("invalid chart: {e}"))?,
-            ),
+                .map_err(|e| format!("invalid chart: {e}"))?;
+                // A chart fitted in s = c'q has c'X'(s) = 1 along its path; a
+                // chart of another mode (or another c) does not, and s would
+                // then silently mean something else.
+                let slope = c.dot(&chart.eval(0.0).dx);
+                if !(0.8..=1.25).contains(&slope) {
+                    return Err(format!(
+                        "chart and eigenvector c do not belong together: c'X'(0) = {slope:.3} \
+                         (a chart fitted in s = c'q has 1); pass the c[j] written with the chart"
+                    ));
+                }
+                Reference::Curved(chart)
+            }
         };
         Controller::new(system, self.config(), reference).map_err(|e| e.to_string())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn paper_settings_build_and_a_foreign_eigenvector_is_refused() {
+        assert!(Settings::paper(Variant::Curved).build().is_ok());
+        assert!(Settings::paper(Variant::Straight).build().is_ok());
+        // The anti-phase direction with the in-phase 14 J chart.
+        let mut s = Settings::paper(Variant::Curved);
+        s.eigenvector = [0.3827, -0.9239];
+        let err = s.build().err().expect("refused");
+        assert!(err.contains("do not belong together"), "{err}");
+        // Straight ignores the chart: any direction is fine.
+        let mut s = Settings::paper(Variant::Straight);
+        s.eigenvector = [0.3827, -0.9239];
+        assert!(s.build().is_ok());
     }
 }
