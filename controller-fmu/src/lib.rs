@@ -143,6 +143,7 @@ pub const STATUS_NOT_CONVERGED: i32 = 1;
 /// previous plan's control, clipped; zero without a plan).
 pub const STATUS_QP_FAILED: i32 = 2;
 /// `solver_status`: the state was NaN/Inf; the torque is the fallback.
+/// C API only: the FMU refuses NaN/Inf inputs with `fmi2Error` before a solve.
 pub const STATUS_INVALID_STATE: i32 = 3;
 /// C API only: a null pointer or otherwise invalid argument; nothing was computed.
 pub const STATUS_BAD_ARGUMENT: i32 = -1;
@@ -178,8 +179,12 @@ compute other charts with <code>eigenmpc modes --energies E --fmu-start-values F
 and load FILE as start values. A negative <code>w_E</code> (the default) selects the paper's \
 energy weight of the variant: 25 curved, 5 straight.</p>\
 <p><b>solver_status.</b> 0 solved; 1 first-sample SQP not converged (torque from the last \
-iterate); 2 QP failed, 3 invalid state: the torque is the fallback (the previous plan's next \
-control, clipped) and a warning is logged.</p>";
+iterate); 2 QP failed: the torque is the fallback (the previous plan's next control, clipped) \
+and a warning is logged. Code 3 (invalid state) belongs to the C API: this FMU refuses NaN/Inf \
+inputs with fmi2Error before any solve.</p>\
+<p><b>Refused values.</b> A value out of range (or NaN/Inf) is refused with fmi2Error; the old \
+value stays in place and readable, and the instance is in the FMI error state: call \
+fmi2Reset to continue.</p>";
 
 fn units() -> Vec<Unit> {
     vec![
@@ -336,8 +341,9 @@ impl Model for EigenMpcFmu {
                 .output()
                 .describe(
                     "Status of the last solve: 0 solved; 1 first-sample SQP not converged \
-                     (torque from the last iterate); 2 QP failed, 3 invalid state (torque = \
-                     fallback: previous plan's next control, clipped)",
+                     (torque from the last iterate); 2 QP failed (torque = fallback: previous \
+                     plan's next control, clipped). 3 (invalid state) only occurs through the \
+                     C API: the FMU refuses NaN/Inf inputs with fmi2Error",
                 )
                 .depends_on(&[]),
         );

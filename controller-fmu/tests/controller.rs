@@ -181,23 +181,35 @@ fn eigenmpc_fmu_energy(z: &SVector<f64, 4>) -> f64 {
 #[test]
 fn off_grid_and_long_steps_warn_once_and_keep_solving() {
     // 10 ms steps: the grid points at 25, 75, ... ms fall inside steps.
+    // Each communication point gets its own state (q[1] = 0.05 + 0.001 i), so
+    // the `energy` output tells exactly which point's inputs the last solve used.
     let mut fmu = Fmu::start(&[], &[], Z0);
     let mut statuses = vec![];
-    let mut changes = 0;
-    let mut last = fmu.tau();
-    for _ in 0..20 {
+    let mut solved_at = vec![];
+    let mut held = eigenmpc_fmu_energy(&SVector::from(Z0));
+    for i in 0..20 {
+        let z = SVector::from([Z0[0] + 0.001 * i as f64, Z0[1], Z0[2], Z0[3]]);
+        assert_eq!(fmu.set(&STATE, z.as_slice()), OK);
+        let t = fmu.t;
         statuses.push(fmu.step(0.01));
-        if fmu.tau() != last {
-            changes += 1;
-            last = fmu.tau();
+        let energy = fmu.real(VR_ENERGY);
+        if i > 0 && energy == eigenmpc_fmu_energy(&z) {
+            solved_at.push(t);
+            held = energy;
+        } else {
+            assert_eq!(energy, held, "no solve at t = {t}: output held");
         }
     }
     assert_eq!(statuses.iter().filter(|&&s| s == WARNING).count(), 1);
     assert!(statuses.iter().all(|&s| s == OK || s == WARNING));
     assert!(fmu.log.contains(&["not on the sample grid"]));
-    // solves at 0.03, 0.05, 0.08, 0.1, ...: 8 solves in 0.2 s (the state is
-    // held constant, so the torque changes as the plan evolves)
-    assert!((6..=8).contains(&changes), "{changes} torque changes");
+    // Grid points 25, 50, ..., 175 ms; each is solved at the first
+    // communication point at or after it (t = 0 was solved at initialization).
+    let expected = [0.03, 0.05, 0.08, 0.10, 0.13, 0.15, 0.18];
+    assert_eq!(solved_at.len(), expected.len(), "solves at {solved_at:?}");
+    for (t, e) in solved_at.iter().zip(expected) {
+        assert!((t - e).abs() < 1e-12, "solves at {solved_at:?}");
+    }
 
     let mut fmu = Fmu::start(&[], &[], Z0);
     let mut warnings = 0;
@@ -241,10 +253,22 @@ fn tunable_parameters_are_followed_and_checked() {
     assert_eq!(model(&fmu).e_ref, 8.0);
     assert_eq!(model(&fmu).weights.energy, 7.5);
     assert_eq!(fmu.step(DT), OK);
-    // out of range: refused, nothing changes
+    // out of range: refused, nothing changes, the old values stay readable;
+    // fmi2Error puts the instance in the FMI error state until fmi2Reset
     assert_eq!(fmu.set(&[VR_E_REF, VR_W_F], &[9.0, 0.0]), ERROR);
     assert!(fmu.log.contains(&["w_F = 0 is below its minimum"]));
     assert_eq!(model(&fmu).e_ref, 8.0);
+    assert_eq!((fmu.real(VR_E_REF), fmu.real(VR_W_F)), (8.0, 225.0));
+    assert_eq!(fmu.step(DT), ERROR);
+    assert!(
+        fmu.log
+            .contains(&["fmi2DoStep: not allowed in state error"])
+    );
+    unsafe {
+        assert_eq!(fmi2Reset(fmu.c), OK);
+        assert_eq!(fmi2EnterInitializationMode(fmu.c), OK);
+    }
+    assert_eq!(fmu.real(VR_E_REF), 14.0, "reset: start values");
 
     let mut fmu = Fmu::start(&[], &[], Z0);
     assert_eq!(fmu.step(DT), OK);
@@ -314,10 +338,25 @@ fn a_failed_solve_returns_the_fallback_with_its_status() {
     assert!(fmu.log.contains(&["QP failed"]));
     let tau = fmu.tau();
     assert!(tau.iter().all(|t| t.is_finite() && t.abs() <= 1.0));
-    // and the controller recovers on sane inputs
+}
+
+/// After a failed QP the controller re-initialises its plan, so the next
+/// sample with a sane state is solved again.
+// PENDING the lead's recovery logic in src/mpc (plan re-initialised after a
+// failed QP): on branch `fmi` before that merge the next solve fails again
+// ("QP failed (InvalidInput)", solver_status 2, fmi2Warning). Remove the
+// #[ignore] when it lands; the assertions must not be weakened.
+#[test]
+#[ignore = "needs the controller's plan re-initialisation after a failed QP (src/mpc, lead)"]
+fn the_controller_recovers_after_a_failed_solve() {
+    let mut fmu = Fmu::start(&[], &[], Z0);
+    assert_eq!(fmu.set(&STATE, &[0.1, 0.1, 1e155, -1e155]), OK);
+    assert_eq!(fmu.step(DT), WARNING);
+    assert_eq!(fmu.integer(VR_SOLVER_STATUS), STATUS_QP_FAILED);
     assert_eq!(fmu.set(&STATE, &Z0), OK);
-    fmu.step(DT);
-    assert!(fmu.tau().iter().all(|t| t.is_finite()));
+    assert_eq!(fmu.step(DT), OK, "{:?}", fmu.log.lines());
+    assert_eq!(fmu.integer(VR_SOLVER_STATUS), STATUS_SOLVED);
+    assert!(fmu.tau().iter().all(|t| t.is_finite() && t.abs() <= 1.0));
 }
 
 #[test]

@@ -429,6 +429,20 @@ pub unsafe fn unsupported<M: Model>(
     unsafe { call::<M>(c, func, |inst| inst.unsupported(func, why)) }
 }
 
+/// A status query this FMU cannot answer (`fmi2GetStatus`,
+/// `fmi2GetIntegerStatus`, `fmi2GetStringStatus`): `fmi2Discard` with a
+/// warning line, the instance stays usable.
+///
+/// # Safety
+/// `c` as for [`call`].
+pub unsafe fn status_unavailable<M: Model>(
+    c: ffi::fmi2Component,
+    func: &'static str,
+    why: &'static str,
+) -> ffi::fmi2Status {
+    unsafe { call::<M>(c, func, |inst| inst.status_unavailable(func, why)) }
+}
+
 /// `fmi2DoStep`.
 ///
 /// # Safety
@@ -458,7 +472,7 @@ pub unsafe fn get_real_status<M: Model>(
                 return null(inst, F, "value");
             }
             if kind != ffi::fmi2StatusKind_fmi2LastSuccessfulTime {
-                return inst.unsupported(F, "only fmi2LastSuccessfulTime is a Real status");
+                return inst.status_unavailable(F, "only fmi2LastSuccessfulTime is a Real status");
             }
             match inst.last_successful_time() {
                 Ok(t) => {
@@ -487,7 +501,7 @@ pub unsafe fn get_boolean_status<M: Model>(
                 return null(inst, F, "value");
             }
             if kind != ffi::fmi2StatusKind_fmi2Terminated {
-                return inst.unsupported(F, "only fmi2Terminated is a Boolean status");
+                return inst.status_unavailable(F, "only fmi2Terminated is a Boolean status");
             }
             match inst.terminate_requested() {
                 Ok(b) => {

@@ -203,11 +203,11 @@ macro_rules! export_fmi2 {
             (_vr: *const __ffi::fmi2ValueReference, _n: usize, _o: *const __ffi::fmi2Integer, _v: *mut __ffi::fmi2Real));
         $crate::export_fmi2!(@unsupported $model, fmi2CancelStep, fmi2CancelStepTYPE,
             "fmi2DoStep never returns fmi2Pending", ());
-        $crate::export_fmi2!(@unsupported $model, fmi2GetStatus, fmi2GetStatusTYPE,
+        $crate::export_fmi2!(@status_unavailable $model, fmi2GetStatus, fmi2GetStatusTYPE,
             "fmi2DoStep never returns fmi2Pending", (_k: __ffi::fmi2StatusKind, _v: *mut __ffi::fmi2Status));
-        $crate::export_fmi2!(@unsupported $model, fmi2GetIntegerStatus, fmi2GetIntegerStatusTYPE,
+        $crate::export_fmi2!(@status_unavailable $model, fmi2GetIntegerStatus, fmi2GetIntegerStatusTYPE,
             "there is no Integer status", (_k: __ffi::fmi2StatusKind, _v: *mut __ffi::fmi2Integer));
-        $crate::export_fmi2!(@unsupported $model, fmi2GetStringStatus, fmi2GetStringStatusTYPE,
+        $crate::export_fmi2!(@status_unavailable $model, fmi2GetStringStatus, fmi2GetStringStatusTYPE,
             "fmi2DoStep never returns fmi2Pending", (_k: __ffi::fmi2StatusKind, _v: *mut __ffi::fmi2String));
 
         /// FMI 2.0 `fmi2DoStep`.
@@ -278,6 +278,23 @@ macro_rules! export_fmi2 {
             value: $value,
         ) -> $crate::ffi::fmi2Status {
             unsafe { $crate::abi::$fn::<$model>(c, vr, nvr, value) }
+        }
+        const _: $crate::ffi::$ty = Some($name);
+    };
+
+    (@status_unavailable $model:ty, $name:ident, $ty:ident, $why:literal, ($($arg:ident : $argty:ty),* $(,)?)) => {
+        /// A status this FMU cannot provide: returns `fmi2Discard` with a
+        /// warning line (FMI 2.0 section 4.2.3); the instance stays usable.
+        ///
+        /// # Safety
+        /// `c` is null or a live instance of this FMU.
+        #[unsafe(no_mangle)]
+        #[allow(non_snake_case)]
+        pub unsafe extern "C" fn $name(
+            c: $crate::ffi::fmi2Component,
+            $($arg: $argty),*
+        ) -> $crate::ffi::fmi2Status {
+            unsafe { $crate::abi::status_unavailable::<$model>(c, stringify!($name), $why) }
         }
         const _: $crate::ffi::$ty = Some($name);
     };

@@ -175,6 +175,9 @@ const READABLE: &[State] = &[
     State::Error,
 ];
 
+/// States in which `fmi2Get*Status` may be called.
+const STATUS_READABLE: &[State] = &[State::StepComplete, State::StepFailed, State::Terminated];
+
 impl<M: Model> Instance<M> {
     /// `fmi2Instantiate`: checks the GUID against the model's; logs and
     /// returns `None` on mismatch or an invalid variable table.
@@ -660,10 +663,7 @@ impl<M: Model> Instance<M> {
 
     /// `fmi2GetRealStatus(fmi2LastSuccessfulTime)`.
     pub fn last_successful_time(&mut self) -> Result<f64, Status> {
-        let r = self.require(
-            "fmi2GetRealStatus",
-            &[State::StepComplete, State::StepFailed, State::Terminated],
-        );
+        let r = self.require("fmi2GetRealStatus", STATUS_READABLE);
         match r {
             Ok(()) => Ok(self.last_successful_time),
             Err(e) => Err(self.conclude(Err(e))),
@@ -673,18 +673,32 @@ impl<M: Model> Instance<M> {
     /// `fmi2GetBooleanStatus(fmi2Terminated)`: whether the slave asks to stop
     /// (after a discarded step it cannot continue).
     pub fn terminate_requested(&mut self) -> Result<bool, Status> {
-        let r = self.require(
-            "fmi2GetBooleanStatus",
-            &[State::StepComplete, State::StepFailed, State::Terminated],
-        );
+        let r = self.require("fmi2GetBooleanStatus", STATUS_READABLE);
         match r {
             Ok(()) => Ok(self.terminate_requested),
             Err(e) => Err(self.conclude(Err(e))),
         }
     }
 
-    /// A function or status kind this FMU does not support: `fmi2Error`.
+    /// A function this FMU does not support: `fmi2Error`.
     pub fn unsupported(&mut self, func: &str, why: &str) -> Status {
         self.conclude(Err(format!("{func}: not supported: {why}")))
+    }
+
+    /// A status (`fmi2Get*Status`) this FMU cannot provide: `fmi2Discard`
+    /// with a warning line and no state change, as FMI 2.0 section 4.2.3
+    /// prescribes ("If a status is required which cannot be retrieved by the
+    /// slave it returns fmi2Discard"). Calls in a state where no status may
+    /// be queried stay errors.
+    pub fn status_unavailable(&mut self, func: &str, why: &str) -> Status {
+        let r = self.require(func, STATUS_READABLE).map(|()| {
+            self.log.log(
+                crate::logger::Category::StatusWarning,
+                Status::Discard,
+                &format!("{func}: status not available: {why}"),
+            );
+            Status::Discard
+        });
+        self.conclude(r)
     }
 }

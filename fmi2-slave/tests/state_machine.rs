@@ -452,16 +452,85 @@ fn warning_discard_and_status_queries() {
         "outputs stay at the last successful time"
     );
     assert_eq!(fmu.step(3.0, 1.0), ERROR, "no step after a discard");
+}
+
+/// FMI 2.0 section 4.2.3: a status the slave cannot provide is answered with
+/// fmi2Discard, the value is left alone and the instance keeps stepping.
+#[test]
+fn unavailable_statuses_are_discarded_and_stepping_continues() {
     let fmu = Fmu::new();
     fmu.init();
-    let mut status = 0;
+    assert_eq!(fmu.set_real(&[U], &[1.0]), OK);
+    assert_eq!(fmu.step(0.0, 0.5), OK);
+    let mut status: ffi::fmi2Status = 77;
+    let mut integer = -7;
+    let mut string: ffi::fmi2String = ptr::null();
+    let mut real = -7.0;
+    let mut boolean = -7;
+    unsafe {
+        assert_eq!(
+            fmi2GetStatus(fmu.c, ffi::fmi2StatusKind_fmi2DoStepStatus, &mut status),
+            DISCARD
+        );
+        assert_eq!(
+            fmi2GetIntegerStatus(fmu.c, ffi::fmi2StatusKind_fmi2DoStepStatus, &mut integer),
+            DISCARD
+        );
+        assert_eq!(
+            fmi2GetStringStatus(fmu.c, ffi::fmi2StatusKind_fmi2PendingStatus, &mut string),
+            DISCARD
+        );
+        assert_eq!(
+            fmi2GetRealStatus(fmu.c, ffi::fmi2StatusKind_fmi2DoStepStatus, &mut real),
+            DISCARD
+        );
+        assert_eq!(
+            fmi2GetBooleanStatus(
+                fmu.c,
+                ffi::fmi2StatusKind_fmi2LastSuccessfulTime,
+                &mut boolean
+            ),
+            DISCARD
+        );
+    }
+    assert_eq!((status, integer, real, boolean), (77, -7, -7.0, -7));
+    assert!(string.is_null());
+    for func in [
+        "fmi2GetStatus",
+        "fmi2GetIntegerStatus",
+        "fmi2GetStringStatus",
+        "fmi2GetRealStatus",
+        "fmi2GetBooleanStatus",
+    ] {
+        assert!(
+            fmu.log
+                .contains(&[&format!("{func}: status not available")]),
+            "{func} explains the discard"
+        );
+    }
+    assert!(!fmu.log.contains(&["not allowed in state"]));
+    // Still in stepComplete: the exact integration continues (x0 = 1, k = 2).
+    assert_eq!(fmu.step(0.5, 0.5), OK);
+    assert_eq!(fmu.real(X), (OK, 3.0));
+    unsafe {
+        assert_eq!(
+            fmi2GetRealStatus(fmu.c, ffi::fmi2StatusKind_fmi2LastSuccessfulTime, &mut real),
+            OK
+        );
+    }
+    assert_eq!(real, 1.0);
+    // Before initialization no status may be queried at all: still an error.
+    let fmu = Fmu::new();
     unsafe {
         assert_eq!(
             fmi2GetStatus(fmu.c, ffi::fmi2StatusKind_fmi2DoStepStatus, &mut status),
             ERROR
         );
     }
-    assert!(fmu.log.contains(&["fmi2GetStatus: not supported"]));
+    assert!(
+        fmu.log
+            .contains(&["fmi2GetStatus: not allowed in state instantiated"])
+    );
 }
 
 #[test]

@@ -1,0 +1,179 @@
+//! Real-time discipline through the exported functions: once initialized,
+//! the per-sample path of the EigenMPC FMU (fmi2SetReal inputs, fmi2DoStep,
+//! fmi2GetReal / fmi2GetInteger outputs) and of the plain C API
+//! (`eigenmpc_step`, `eigenmpc_last_step`) performs no heap allocation.
+//!
+//! Its own test binary: the global allocator counts the allocations of the
+//! thread that switched counting on, so other tests cannot interfere.
+
+use eigenmpc::integrate::rk4_step;
+use eigenmpc::mechanics::{DoublePendulum, Vector};
+use eigenmpc_fmu::capi::*;
+use eigenmpc_fmu::fmi2_exports::*;
+use eigenmpc_fmu::*;
+use fmi2_slave::testing::LogCapture;
+use fmi2_slave::{Model, ffi, xml};
+use nalgebra::SVector;
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+use std::ffi::CString;
+use std::ptr;
+
+/// Counts allocations (alloc, alloc_zeroed, realloc) made while the calling
+/// thread's `COUNTING` flag is set.
+struct CountingAllocator;
+
+thread_local! {
+    // const-initialized Cells: reading them never allocates.
+    static COUNTING: Cell<bool> = const { Cell::new(false) };
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
+
+fn note() {
+    // `try_with`: during thread teardown the locals may be gone.
+    let _ = COUNTING.try_with(|c| {
+        if c.get() {
+            let _ = ALLOCATIONS.try_with(|n| n.set(n.get() + 1));
+        }
+    });
+}
+
+// SAFETY: forwards to the system allocator unchanged.
+unsafe impl GlobalAlloc for CountingAllocator {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        note();
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        note();
+        unsafe { System.alloc_zeroed(layout) }
+    }
+    unsafe fn realloc(&self, p: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        note();
+        unsafe { System.realloc(p, layout, new_size) }
+    }
+    unsafe fn dealloc(&self, p: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(p, layout) }
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: CountingAllocator = CountingAllocator;
+
+/// Runs `f` with counting on; returns its result and the allocations it made.
+fn counted<T>(f: impl FnOnce() -> T) -> (T, usize) {
+    ALLOCATIONS.with(|n| n.set(0));
+    COUNTING.with(|c| c.set(true));
+    let r = f();
+    COUNTING.with(|c| c.set(false));
+    (r, ALLOCATIONS.with(|n| n.get()))
+}
+
+const OK: ffi::fmi2Status = ffi::fmi2Status_fmi2OK;
+const Z0: [f64; 4] = [0.05, 0.05, 0.0, 0.0];
+const DT: f64 = 0.025;
+const SAMPLES: usize = 200;
+
+/// The plant between samples (outside the counted region).
+fn plant_step(z: &SVector<f64, 4>, tau: [f64; 2]) -> SVector<f64, 4> {
+    let sys = DoublePendulum::default();
+    let tau = Vector::<2>::from(tau);
+    let mut z = *z;
+    for _ in 0..5 {
+        z = rk4_step::<_, 2, 4>(&sys, &z, &tau, DT / 5.0);
+    }
+    z
+}
+
+#[test]
+fn the_counter_sees_allocations() {
+    let (v, n) = counted(|| vec![1.0_f64; 8]);
+    assert_eq!((v.len(), n), (8, 1));
+}
+
+#[test]
+fn fmu_sample_path_does_not_allocate() {
+    let log = LogCapture::new();
+    let callbacks = Box::new(log.callbacks());
+    let name = CString::new("no_alloc").unwrap();
+    let guid = CString::new(xml::guid(&EigenMpcFmu::description())).unwrap();
+    let state_vr = [VR_Q1, VR_Q2, VR_QD1, VR_QD2];
+    let out_vr = [VR_TAU1, VR_TAU2, VR_ENERGY, VR_SOLVE_TIME];
+    let int_vr = [VR_QP_ITERATIONS, VR_SOLVER_STATUS];
+    let mut z = SVector::<f64, 4>::from(Z0);
+    unsafe {
+        let c = fmi2Instantiate(
+            name.as_ptr(),
+            ffi::fmi2Type_fmi2CoSimulation,
+            guid.as_ptr(),
+            ptr::null(),
+            &*callbacks,
+            0,
+            0, // logging off: the host's default
+        );
+        assert!(!c.is_null());
+        assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), OK);
+        assert_eq!(fmi2EnterInitializationMode(c), OK);
+        assert_eq!(fmi2SetReal(c, state_vr.as_ptr(), 4, z.as_ptr()), OK);
+        assert_eq!(fmi2ExitInitializationMode(c), OK);
+        let mut out = [f64::NAN; 4];
+        let mut ints = [-1; 2];
+        let mut t = 0.0;
+        let mut worst = 0;
+        let mut energy = 0.0;
+        for k in 0..SAMPLES {
+            let (statuses, n) = counted(|| {
+                [
+                    fmi2SetReal(c, state_vr.as_ptr(), 4, z.as_ptr()),
+                    fmi2DoStep(c, t, DT, 1),
+                    fmi2GetReal(c, out_vr.as_ptr(), 4, out.as_mut_ptr()),
+                    fmi2GetInteger(c, int_vr.as_ptr(), 2, ints.as_mut_ptr()),
+                ]
+            });
+            assert_eq!(statuses, [OK; 4], "sample {k}: {:?}", log.lines());
+            assert_eq!(ints[1], STATUS_SOLVED, "sample {k}");
+            assert!(ints[0] > 0 && out[3] > 0.0, "sample {k}: a solve happened");
+            worst = worst.max(n);
+            assert_eq!(n, 0, "sample {k}: {n} allocations in the FMU's sample path");
+            energy = out[2];
+            t += DT;
+            z = plant_step(&z, [out[0], out[1]]);
+        }
+        // The loop really pumps energy (the controller is not idling).
+        assert!(energy > 1.0, "energy {energy} J after {SAMPLES} samples");
+        assert_eq!(worst, 0);
+        assert!(log.lines().is_empty(), "{:?}", log.lines());
+        fmi2FreeInstance(c);
+    }
+}
+
+#[test]
+fn c_api_step_does_not_allocate() {
+    let config = eigenmpc_config_default(VARIANT_CURVED);
+    let mut z = SVector::<f64, 4>::from(Z0);
+    unsafe {
+        let mpc = eigenmpc_create(&config, ptr::null(), ptr::null_mut(), 0);
+        assert!(!mpc.is_null());
+        let mut tau = [f64::NAN; 2];
+        let mut info = EigenMpcStepInfo {
+            status: -5,
+            qp_iterations: 0,
+            solve_time: 0.0,
+            energy: f64::NAN,
+        };
+        for k in 0..SAMPLES {
+            let ((status, last), n) = counted(|| {
+                (
+                    eigenmpc_step(mpc, z.as_ptr(), tau.as_mut_ptr()),
+                    eigenmpc_last_step(mpc, &mut info),
+                )
+            });
+            assert_eq!((status, last), (STATUS_SOLVED, 0), "sample {k}");
+            assert!(info.qp_iterations > 0, "sample {k}: a solve happened");
+            assert_eq!(n, 0, "sample {k}: {n} allocations in eigenmpc_step");
+            z = plant_step(&z, tau);
+        }
+        assert!(info.energy > 1.0, "energy {} J", info.energy);
+        eigenmpc_free(mpc);
+    }
+}
