@@ -340,14 +340,9 @@ fn a_failed_solve_returns_the_fallback_with_its_status() {
     assert!(tau.iter().all(|t| t.is_finite() && t.abs() <= 1.0));
 }
 
-/// After a failed QP the controller re-initialises its plan, so the next
-/// sample with a sane state is solved again.
-// PENDING the lead's recovery logic in src/mpc (plan re-initialised after a
-// failed QP): on branch `fmi` before that merge the next solve fails again
-// ("QP failed (InvalidInput)", solver_status 2, fmi2Warning). Remove the
-// #[ignore] when it lands; the assertions must not be weakened.
+/// After a failed QP with a non-finite plan the controller re-initialises its
+/// plan, so the next sample with a sane state is solved again.
 #[test]
-#[ignore = "needs the controller's plan re-initialisation after a failed QP (src/mpc, lead)"]
 fn the_controller_recovers_after_a_failed_solve() {
     let mut fmu = Fmu::start(&[], &[], Z0);
     assert_eq!(fmu.set(&STATE, &[0.1, 0.1, 1e155, -1e155]), OK);
