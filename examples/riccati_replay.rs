@@ -5,49 +5,26 @@
 //!
 //! `cargo run --release --example riccati_replay [-- SECONDS [REPEATS]]`
 
-use eigenmpc::integrate::{Dopri5, Tolerances};
 use eigenmpc::mechanics::DoublePendulum;
-use eigenmpc::mechanics::state_derivative;
-use eigenmpc::modes::linear_modes;
-use eigenmpc::mpc::closed_loop::mode_and_chart;
-use eigenmpc::mpc::{Controller, MpcConfig, QpBackend, Reference, Variant};
+use eigenmpc::mpc::closed_loop::{reference_for, run_with};
+use eigenmpc::mpc::{Controller, MpcConfig, QpBackend, Variant};
 use eigenmpc::qp::{OcpQp, QpSolution, QpSolver, RiccatiSettings, RiccatiSolver};
 use nalgebra::SVector;
 use std::time::Instant;
 
 fn record(variant: Variant, seconds: f64) -> Vec<OcpQp> {
     let sys = DoublePendulum::default();
-    let reference = match variant {
-        Variant::Straight => Reference::Straight {
-            eigenvector: linear_modes(&sys).unwrap()[0].eigenvector,
-        },
-        Variant::Curved => {
-            Reference::Curved(mode_and_chart::<_, 2, 4>(&sys, 0, 14.0, 9).unwrap().1)
-        }
-    };
+    let reference = reference_for::<_, 2, 4>(&sys, variant, 0, 14.0).unwrap();
     let mut config = MpcConfig::paper(variant);
     config.qp = QpBackend::Riccati;
-    let dt = config.dt;
     let mut ctrl = Controller::<_, 2, 4>::new(sys, config, reference).unwrap();
-    let tol = Tolerances {
-        rtol: 1e-10,
-        atol: 1e-10,
-    };
-    let mut plant = Dopri5::new(0.0, SVector::<f64, 4>::new(0.05, 0.05, 0.0, 0.0), tol);
     let mut qps = Vec::new();
-    let steps = (seconds / dt).round() as usize;
-    for i in 0..steps {
-        let z = *plant.state();
-        let out = ctrl.step(&z);
-        qps.push(ctrl.last_qp().0.clone());
-        let tau = out.tau;
-        plant
-            .advance_to(
-                |_, z| state_derivative::<_, 2, 4>(&sys, z, &tau),
-                (i + 1) as f64 * dt,
-            )
-            .unwrap();
-    }
+    let z0 = SVector::<f64, 4>::new(0.05, 0.05, 0.0, 0.0);
+    let duration = seconds - config.dt;
+    run_with(&mut ctrl, &sys, &z0, duration, |_, ctrl, _| {
+        qps.push(ctrl.last_qp().0.clone())
+    })
+    .unwrap();
     qps
 }
 

@@ -5,12 +5,9 @@
 //! checked against clarabel with accurate settings: first control within
 //! 1e-6, objective within 1e-8 relative, KKT residuals within 1e-8.
 
-use eigenmpc::integrate::{Dopri5, Tolerances};
 use eigenmpc::mechanics::DoublePendulum;
-use eigenmpc::mechanics::state_derivative;
-use eigenmpc::modes::linear_modes;
-use eigenmpc::mpc::closed_loop::mode_and_chart;
-use eigenmpc::mpc::{Controller, MpcConfig, QpBackend, Reference, Variant};
+use eigenmpc::mpc::closed_loop::{reference_for, run_with};
+use eigenmpc::mpc::{Controller, MpcConfig, QpBackend, Variant};
 use eigenmpc::qp::clarabel::{ClarabelQpSolver, accurate_settings};
 use eigenmpc::qp::{QpSolution, QpSolver, QpStatus, kkt_residuals};
 use nalgebra::SVector;
@@ -42,14 +39,7 @@ fn check_scenario(
     stride: usize,
 ) -> Worst {
     let sys = DoublePendulum::default();
-    let reference = match variant {
-        Variant::Straight => Reference::Straight {
-            eigenvector: linear_modes(&sys).unwrap()[0].eigenvector,
-        },
-        Variant::Curved => {
-            Reference::Curved(mode_and_chart::<_, 2, 4>(&sys, 0, 14.0, 9).unwrap().1)
-        }
-    };
+    let reference = reference_for::<_, 2, 4>(&sys, variant, 0, 14.0).unwrap();
     let mut config = MpcConfig::paper(variant);
     config.tau_max = tau_max;
     config.qp = QpBackend::Riccati;
@@ -59,17 +49,11 @@ fn check_scenario(
     let mut clarabel = ClarabelQpSolver::new(4, 2, n, accurate_settings());
     let mut reference_sol = QpSolution::new(4, 2, n);
 
-    let tol = Tolerances {
-        rtol: 1e-10,
-        atol: 1e-10,
-    };
     let z0 = SVector::<f64, 4>::new(q0[0], q0[1], 0.0, 0.0);
-    let mut plant = Dopri5::new(0.0, z0, tol);
     let mut worst = Worst::default();
     let what = format!("{variant} q0 {q0:?} tau_max {tau_max}");
-    for i in 0..samples {
-        let z = *plant.state();
-        let out = ctrl.step(&z);
+    let duration = (samples - 1) as f64 * config.dt;
+    run_with(&mut ctrl, &sys, &z0, duration, |i, ctrl, out| {
         assert!(out.status.is_ok(), "{what} sample {i}: {}", out.status);
         // The first sample is the converged SQP; its last QP counts too.
         if i % stride == 0 {
@@ -118,14 +102,8 @@ fn check_scenario(
                 }
             }
         }
-        let tau = out.tau;
-        plant
-            .advance_to(
-                |_, z| state_derivative::<DoublePendulum, 2, 4>(&sys, z, &tau),
-                (i + 1) as f64 * config.dt,
-            )
-            .unwrap();
-    }
+    })
+    .unwrap();
     eprintln!("{what}: {worst:?}");
     worst
 }

@@ -9,9 +9,8 @@
 //! reported separately and excluded from the per-sample statistics.
 
 use eigenmpc::mechanics::DoublePendulum;
-use eigenmpc::modes::linear_modes;
-use eigenmpc::mpc::closed_loop::{Sample, mode_and_chart, quantile, run};
-use eigenmpc::mpc::{Controller, MpcConfig, QpBackend, Reference, Variant};
+use eigenmpc::mpc::closed_loop::{Sample, quantile, reference_for, run};
+use eigenmpc::mpc::{Controller, MpcConfig, QpBackend, Variant};
 use nalgebra::SVector;
 
 fn stats(mut v: Vec<f64>) -> [f64; 4] {
@@ -41,15 +40,7 @@ fn run_case(
     backend: QpBackend,
 ) -> Vec<Sample<2, 4>> {
     let sys = DoublePendulum::default();
-    let reference = match variant {
-        Variant::Straight => Reference::Straight {
-            eigenvector: linear_modes(&sys).expect("linear modes")[0].eigenvector,
-        },
-        Variant::Curved => {
-            let (_, chart) = mode_and_chart::<_, 2, 4>(&sys, 0, 14.0, 9).expect("14 J mode");
-            Reference::Curved(chart)
-        }
-    };
+    let reference = reference_for::<_, 2, 4>(&sys, variant, 0, 14.0).expect("14 J mode");
     let mut config = MpcConfig::paper(variant);
     config.horizon = horizon;
     config.qp = backend;

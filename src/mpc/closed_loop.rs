@@ -2,7 +2,7 @@
 //! (adaptive Dormand-Prince, torque held over each sample) and the summary
 //! figures of the paper's scenarios.
 
-use super::{ControlStatus, Controller};
+use super::{ControlOutput, ControlStatus, Controller};
 use crate::integrate::{Dopri5, IntegrationError, Tolerances};
 use crate::mechanics::{MechanicalSystem, Vector, state_derivative, state_energy};
 use nalgebra::SVector;
@@ -40,6 +40,22 @@ where
     S: MechanicalSystem<N>,
     P: MechanicalSystem<N>,
 {
+    run_with(controller, plant, z0, duration, |_, _, _| {})
+}
+
+/// [`run`], calling `on_sample(i, controller, output)` right after the
+/// controller's step at sample `i` (e.g. to inspect or record its QP).
+pub fn run_with<S, P, const N: usize, const NX: usize>(
+    controller: &mut Controller<S, N, NX>,
+    plant: &P,
+    z0: &SVector<f64, NX>,
+    duration: f64,
+    mut on_sample: impl FnMut(usize, &Controller<S, N, NX>, &ControlOutput<N>),
+) -> Result<Vec<Sample<N, NX>>, IntegrationError>
+where
+    S: MechanicalSystem<N>,
+    P: MechanicalSystem<N>,
+{
     let dt = controller.config().dt;
     let steps = (duration / dt).round() as usize;
     let mut trace = Vec::with_capacity(steps + 1);
@@ -52,6 +68,7 @@ where
         let t = i as f64 * dt;
         let z = *ode.state();
         let out = controller.step(&z);
+        on_sample(i, controller, &out);
         trace.push(Sample {
             time: t,
             state: z,
@@ -72,6 +89,34 @@ where
         )?;
     }
     Ok(trace)
+}
+
+/// The cost reference of `variant` for the family `mode_index` at `energy`:
+/// the unit linear eigenvector (straight) or the degree-9 chart of the true
+/// eigenmode (curved).
+pub fn reference_for<S, const N: usize, const NX: usize>(
+    system: &S,
+    variant: super::Variant,
+    mode_index: usize,
+    energy: f64,
+) -> Result<super::Reference<N>, crate::modes::ModeError>
+where
+    S: MechanicalSystem<N>,
+{
+    Ok(match variant {
+        super::Variant::Straight => super::Reference::Straight {
+            eigenvector: crate::modes::linear_modes(system)?
+                .get(mode_index)
+                .ok_or(crate::modes::ModeError::NoSuchMode {
+                    index: mode_index,
+                    dof: N,
+                })?
+                .eigenvector,
+        },
+        super::Variant::Curved => {
+            super::Reference::Curved(mode_and_chart::<S, N, NX>(system, mode_index, energy, 9)?.1)
+        }
+    })
 }
 
 /// Summary figures of a run (issue 3 / paper section V).
