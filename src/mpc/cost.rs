@@ -267,17 +267,21 @@ where
         + r.velocity_z.transpose() * r.velocity * w.velocity
         + r.torque_z.transpose() * r.torque * w.torque;
     StageModel {
-        cost: scale
-            * (w.energy * r.energy * r.energy
-                + w.position * r.position.norm_squared()
-                + w.velocity * r.velocity.norm_squared()
-                + w.torque * r.torque.norm_squared()),
+        cost: scale * weighted_square_sum(&r, w),
         q: q * two,
         s: r.torque_u.transpose() * r.torque_z * (two * w.torque),
         r: r.torque_u.transpose() * r.torque_u * (two * w.torque),
         gz: gz * two,
         gu: r.torque_u.transpose() * r.torque * (two * w.torque),
     }
+}
+
+/// `l = sum_i w_i r_i^2` of one stage's residuals.
+fn weighted_square_sum<const N: usize, const NX: usize>(r: &Residuals<N, NX>, w: &Weights) -> f64 {
+    w.energy * r.energy * r.energy
+        + w.position * r.position.norm_squared()
+        + w.velocity * r.velocity.norm_squared()
+        + w.torque * r.torque.norm_squared()
 }
 
 /// `scale * l(z, tau)` only (line search, reporting).
@@ -293,10 +297,5 @@ where
     S: MechanicalSystem<N> + ?Sized,
 {
     let r = residuals::<S, N, NX>(system, reference, params, z, tau);
-    let w = &params.weights;
-    scale
-        * (w.energy * r.energy * r.energy
-            + w.position * r.position.norm_squared()
-            + w.velocity * r.velocity.norm_squared()
-            + w.torque * r.torque.norm_squared())
+    scale * weighted_square_sum(&r, &params.weights)
 }
