@@ -11,10 +11,10 @@ use eigenmpc_fmu::capi::*;
 use eigenmpc_fmu::fmi2_exports::*;
 use eigenmpc_fmu::settings::{CHART_COEFFICIENTS, Settings};
 use eigenmpc_fmu::*;
-use fmi2_slave::testing::LogCapture;
+use fmi2_slave::testing::TestInstance;
 use fmi2_slave::{Model, Value, ffi, xml};
 use nalgebra::SVector;
-use std::ffi::{CStr, CString};
+use std::ffi::CStr;
 use std::path::PathBuf;
 use std::ptr;
 
@@ -25,33 +25,16 @@ const STATE: [u32; 4] = [VR_Q1, VR_Q2, VR_QD1, VR_QD2];
 
 struct Fmu {
     c: ffi::fmi2Component,
-    log: Box<LogCapture>,
-    _callbacks: Box<ffi::fmi2CallbackFunctions>,
+    instance: TestInstance,
     t: f64,
 }
 
 impl Fmu {
     fn instantiate() -> Self {
-        let log = LogCapture::new();
-        let callbacks = Box::new(log.callbacks());
-        let name = CString::new("controller").unwrap();
-        let guid = CString::new(xml::guid(&EigenMpcFmu::description())).unwrap();
-        let c = unsafe {
-            fmi2Instantiate(
-                name.as_ptr(),
-                ffi::fmi2Type_fmi2CoSimulation,
-                guid.as_ptr(),
-                ptr::null(),
-                &*callbacks,
-                0,
-                0,
-            )
-        };
-        assert!(!c.is_null());
+        let instance = TestInstance::new::<EigenMpcFmu>(Some(fmi2Instantiate), "controller");
         Self {
-            c,
-            log,
-            _callbacks: callbacks,
+            c: instance.component,
+            instance,
             t: 0.0,
         }
     }
@@ -60,10 +43,15 @@ impl Fmu {
     fn start(params: &[(u32, f64)], integers: &[(u32, i32)], z0: [f64; 4]) -> Self {
         let fmu = Self::instantiate();
         for &(vr, v) in params {
-            assert_eq!(fmu.set(&[vr], &[v]), OK, "{:?}", fmu.log.lines());
+            assert_eq!(fmu.set(&[vr], &[v]), OK, "{:?}", fmu.instance.log.lines());
         }
         for &(vr, v) in integers {
-            assert_eq!(fmu.set_int(&[vr], &[v]), OK, "{:?}", fmu.log.lines());
+            assert_eq!(
+                fmu.set_int(&[vr], &[v]),
+                OK,
+                "{:?}",
+                fmu.instance.log.lines()
+            );
         }
         unsafe {
             assert_eq!(fmi2SetupExperiment(fmu.c, 0, 0.0, 0.0, 0, 0.0), OK);
@@ -73,7 +61,7 @@ impl Fmu {
                 fmi2ExitInitializationMode(fmu.c),
                 OK,
                 "{:?}",
-                fmu.log.lines()
+                fmu.instance.log.lines()
             );
         }
         fmu
@@ -153,7 +141,7 @@ fn solves_on_the_sample_grid_and_holds_in_between() {
     assert!(fmu.integer(VR_QP_ITERATIONS) > 0);
     for (k, (z, tau)) in native.iter().enumerate().take(native.len() - 1) {
         assert_eq!(fmu.set(&STATE, z.as_slice()), OK);
-        assert_eq!(fmu.step(DT), OK, "{:?}", fmu.log.lines());
+        assert_eq!(fmu.step(DT), OK, "{:?}", fmu.instance.log.lines());
         assert_eq!(fmu.tau(), [tau[0], tau[1]], "sample {k}");
         let e = eigenmpc_fmu_energy(z);
         assert!((fmu.real(VR_ENERGY) - e).abs() < 1e-12);
@@ -171,7 +159,7 @@ fn solves_on_the_sample_grid_and_holds_in_between() {
             assert_eq!(fmu.tau(), [tau[0], tau[1]], "sample {k}, substep {i}");
         }
     }
-    assert!(fmu.log.lines().iter().all(|l| l.status == OK));
+    assert!(fmu.instance.log.lines().iter().all(|l| l.status == OK));
 }
 
 fn eigenmpc_fmu_energy(z: &SVector<f64, 4>) -> f64 {
@@ -202,7 +190,7 @@ fn off_grid_and_long_steps_warn_once_and_keep_solving() {
     }
     assert_eq!(statuses.iter().filter(|&&s| s == WARNING).count(), 1);
     assert!(statuses.iter().all(|&s| s == OK || s == WARNING));
-    assert!(fmu.log.contains(&["not on the sample grid"]));
+    assert!(fmu.instance.log.contains(&["not on the sample grid"]));
     // Grid points 25, 50, ..., 175 ms; each is solved at the first
     // communication point at or after it (t = 0 was solved at initialization).
     let expected = [0.03, 0.05, 0.08, 0.10, 0.13, 0.15, 0.18];
@@ -225,7 +213,11 @@ fn off_grid_and_long_steps_warn_once_and_keep_solving() {
         last = fmu.tau();
     }
     assert_eq!(warnings, 1);
-    assert!(fmu.log.contains(&["longer than the sample period"]));
+    assert!(
+        fmu.instance
+            .log
+            .contains(&["longer than the sample period"])
+    );
 }
 
 #[test]
@@ -256,12 +248,13 @@ fn tunable_parameters_are_followed_and_checked() {
     // out of range: refused, nothing changes, the old values stay readable;
     // fmi2Error puts the instance in the FMI error state until fmi2Reset
     assert_eq!(fmu.set(&[VR_E_REF, VR_W_F], &[9.0, 0.0]), ERROR);
-    assert!(fmu.log.contains(&["w_F = 0 is below its minimum"]));
+    assert!(fmu.instance.log.contains(&["w_F = 0 is below its minimum"]));
     assert_eq!(model(&fmu).e_ref, 8.0);
     assert_eq!((fmu.real(VR_E_REF), fmu.real(VR_W_F)), (8.0, 225.0));
     assert_eq!(fmu.step(DT), ERROR);
     assert!(
-        fmu.log
+        fmu.instance
+            .log
             .contains(&["fmi2DoStep: not allowed in state error"])
     );
     unsafe {
@@ -274,7 +267,8 @@ fn tunable_parameters_are_followed_and_checked() {
     assert_eq!(fmu.step(DT), OK);
     assert_eq!(fmu.set(&[VR_TAU_MAX], &[2.0]), ERROR, "fixed in step mode");
     assert!(
-        fmu.log
+        fmu.instance
+            .log
             .contains(&["tau_max", "cannot be set in state stepComplete"])
     );
 }
@@ -294,11 +288,19 @@ fn invalid_parameters_are_rejected_with_a_message() {
     ] {
         let fmu = Fmu::instantiate();
         assert_eq!(fmu.set(&[vr], &[v]), ERROR);
-        assert!(fmu.log.contains(&[needle]), "{:?}", fmu.log.lines());
+        assert!(
+            fmu.instance.log.contains(&[needle]),
+            "{:?}",
+            fmu.instance.log.lines()
+        );
     }
     let fmu = Fmu::instantiate();
     assert_eq!(fmu.set_int(&[VR_VARIANT], &[3]), ERROR);
-    assert!(fmu.log.contains(&["variant = 3 is above its maximum"]));
+    assert!(
+        fmu.instance
+            .log
+            .contains(&["variant = 3 is above its maximum"])
+    );
     assert_eq!(unsafe { fmi2Reset(fmu.c) }, OK);
     assert_eq!(fmu.set_int(&[VR_HORIZON], &[0]), ERROR);
     // relations checked at exitInitializationMode
@@ -309,7 +311,8 @@ fn invalid_parameters_are_rejected_with_a_message() {
         assert_eq!(fmi2ExitInitializationMode(fmu.c), ERROR);
     }
     assert!(
-        fmu.log
+        fmu.instance
+            .log
             .contains(&["fmi2ExitInitializationMode", "eigenvector"])
     );
 }
@@ -332,10 +335,10 @@ fn a_failed_solve_returns_the_fallback_with_its_status() {
     let mut fmu = Fmu::start(&[], &[], Z0);
     assert_eq!(fmu.set(&STATE, &[0.1, 0.1, 1e155, -1e155]), OK);
     let status = fmu.step(DT);
-    assert_eq!(status, WARNING, "{:?}", fmu.log.lines());
+    assert_eq!(status, WARNING, "{:?}", fmu.instance.log.lines());
     let code = fmu.integer(VR_SOLVER_STATUS);
     assert_eq!(code, STATUS_QP_FAILED);
-    assert!(fmu.log.contains(&["QP failed"]));
+    assert!(fmu.instance.log.contains(&["QP failed"]));
     let tau = fmu.tau();
     assert!(tau.iter().all(|t| t.is_finite() && t.abs() <= 1.0));
 }
@@ -349,7 +352,7 @@ fn the_controller_recovers_after_a_failed_solve() {
     assert_eq!(fmu.step(DT), WARNING);
     assert_eq!(fmu.integer(VR_SOLVER_STATUS), STATUS_QP_FAILED);
     assert_eq!(fmu.set(&STATE, &Z0), OK);
-    assert_eq!(fmu.step(DT), OK, "{:?}", fmu.log.lines());
+    assert_eq!(fmu.step(DT), OK, "{:?}", fmu.instance.log.lines());
     assert_eq!(fmu.integer(VR_SOLVER_STATUS), STATUS_SOLVED);
     assert!(fmu.tau().iter().all(|t| t.is_finite() && t.abs() <= 1.0));
 }

@@ -148,3 +148,45 @@ pub fn assert_exports_fmi2_cs(library: &std::path::Path) -> Vec<String> {
     assert_eq!(fmi.len(), 34, "{fmi:?}");
     exported
 }
+
+/// A co-simulation instance created through an FMU's exported
+/// `fmi2Instantiate`, with its log captured (test harnesses of the FMU crates).
+pub struct TestInstance {
+    /// The component handle.
+    pub component: ffi::fmi2Component,
+    /// Messages the instance logged.
+    pub log: Box<LogCapture>,
+    /// Kept alive for the instance's lifetime (the FMU holds a pointer).
+    _callbacks: Box<ffi::fmi2CallbackFunctions>,
+}
+
+impl TestInstance {
+    /// Instantiates `M` through `instantiate` (the crate's exported
+    /// `fmi2Instantiate`) with the GUID of its description; panics on NULL.
+    pub fn new<M: crate::Model>(instantiate: ffi::fmi2InstantiateTYPE, name: &str) -> Self {
+        let log = LogCapture::new();
+        let callbacks = Box::new(log.callbacks());
+        let name = std::ffi::CString::new(name).expect("instance name");
+        let guid = std::ffi::CString::new(crate::xml::guid(&M::description())).expect("guid");
+        let instantiate = instantiate.expect("fmi2Instantiate");
+        // SAFETY: valid NUL-terminated strings and callbacks that outlive the
+        // instance (kept in the returned value).
+        let component = unsafe {
+            instantiate(
+                name.as_ptr(),
+                ffi::fmi2Type_fmi2CoSimulation,
+                guid.as_ptr(),
+                std::ptr::null(),
+                &*callbacks,
+                0,
+                0,
+            )
+        };
+        assert!(!component.is_null(), "fmi2Instantiate returned NULL");
+        Self {
+            component,
+            log,
+            _callbacks: callbacks,
+        }
+    }
+}

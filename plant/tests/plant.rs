@@ -5,7 +5,7 @@
 
 use double_pendulum_fmu::fmi2_exports::*;
 use double_pendulum_fmu::*;
-use fmi2_slave::testing::LogCapture;
+use fmi2_slave::testing::{LogCapture, TestInstance};
 use fmi2_slave::{Model, ffi, xml};
 use std::ffi::CString;
 use std::path::PathBuf;
@@ -17,8 +17,7 @@ const OUTPUTS: [u32; 5] = [VR_Q1, VR_Q2, VR_QD1, VR_QD2, VR_ENERGY];
 
 struct Fmu {
     c: ffi::fmi2Component,
-    log: Box<LogCapture>,
-    _callbacks: Box<ffi::fmi2CallbackFunctions>,
+    instance: TestInstance,
     t: f64,
 }
 
@@ -27,7 +26,7 @@ impl Fmu {
     fn start(params: &[(u32, f64)]) -> Self {
         let fmu = Self::instantiate();
         for &(vr, v) in params {
-            assert_eq!(fmu.set(&[vr], &[v]), OK, "{:?}", fmu.log.lines());
+            assert_eq!(fmu.set(&[vr], &[v]), OK, "{:?}", fmu.instance.log.lines());
         }
         unsafe {
             assert_eq!(fmi2SetupExperiment(fmu.c, 0, 0.0, 0.0, 0, 0.0), OK);
@@ -38,26 +37,10 @@ impl Fmu {
     }
 
     fn instantiate() -> Self {
-        let log = LogCapture::new();
-        let callbacks = Box::new(log.callbacks());
-        let name = CString::new("pendulum").unwrap();
-        let guid = CString::new(xml::guid(&DoublePendulumFmu::description())).unwrap();
-        let c = unsafe {
-            fmi2Instantiate(
-                name.as_ptr(),
-                ffi::fmi2Type_fmi2CoSimulation,
-                guid.as_ptr(),
-                ptr::null(),
-                &*callbacks,
-                0,
-                0,
-            )
-        };
-        assert!(!c.is_null());
+        let instance = TestInstance::new::<DoublePendulumFmu>(Some(fmi2Instantiate), "pendulum");
         Self {
-            c,
-            log,
-            _callbacks: callbacks,
+            c: instance.component,
+            instance,
             t: 0.0,
         }
     }
@@ -80,7 +63,7 @@ impl Fmu {
             unsafe { fmi2DoStep(self.c, self.t, h, 1) },
             OK,
             "{:?}",
-            self.log.lines()
+            self.instance.log.lines()
         );
         self.t += h;
     }
@@ -218,7 +201,11 @@ fn invalid_parameters_and_inputs_are_rejected() {
     ] {
         let fmu = Fmu::instantiate();
         assert_eq!(fmu.set(&[vr], &[v]), ERROR);
-        assert!(fmu.log.contains(&[needle]), "{:?}", fmu.log.lines());
+        assert!(
+            fmu.instance.log.contains(&[needle]),
+            "{:?}",
+            fmu.instance.log.lines()
+        );
     }
     let mut fmu = Fmu::start(&[]);
     fmu.step(0.1);
@@ -231,7 +218,8 @@ fn invalid_parameters_and_inputs_are_rejected() {
     fmu.step(0.1);
     assert_eq!(fmu.set(&[VR_ENERGY], &[2.0]), ERROR, "output");
     assert!(
-        fmu.log
+        fmu.instance
+            .log
             .contains(&["energy (value reference 6, causality Output"])
     );
 }
