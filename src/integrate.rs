@@ -307,12 +307,22 @@ impl<S: OdeState> Dopri5<S> {
             .sqrt()
     }
 
-    /// Initial step guess (Hairer's algorithm, simplified).
+    /// Initial step guess (Hairer, Norsett & Wanner, Solving ODEs I, II.4).
+    ///
+    /// When the state or its derivative is below the tolerance scale (a
+    /// start from rest with `atol = 1e-12`), `d0 / d1` says nothing about the
+    /// time scale, and the rule falls back to `h0 = 1e-6` instead of the
+    /// ratio (which collapses to ~1e-17 s and underflows).
     fn initial_step(&mut self, f: &mut impl FnMut(f64, &S) -> S, dy0: &S, span: f64) -> f64 {
         let zero = self.y * 0.0;
-        let d0 = self.error_norm(&self.y, &zero, &zero).max(1e-5);
-        let d1 = self.error_norm(dy0, &self.y, &self.y).max(1e-5);
-        let h0 = (0.01 * d0 / d1).min(span.abs());
+        let d0 = self.error_norm(&self.y, &zero, &zero);
+        let d1 = self.error_norm(dy0, &self.y, &self.y);
+        let h0 = if d0 < 1e-5 || d1 < 1e-5 {
+            1e-6
+        } else {
+            0.01 * d0 / d1
+        }
+        .min(span.abs());
         let y1 = self.y + *dy0 * h0;
         let dy1 = f(self.t + h0, &y1);
         self.evaluations += 1;

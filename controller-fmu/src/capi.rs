@@ -102,12 +102,7 @@ fn settings_from(config: &EigenMpcConfig) -> Result<Settings, String> {
         tau_max: config.tau_max,
         horizon: config.horizon as usize,
         sample_period: config.sample_period,
-        model: PlanarChainParams {
-            masses: config.masses,
-            lengths: config.lengths,
-            gravity: config.gravity,
-            ..Default::default()
-        },
+        model: PlanarChainParams::point_masses(config.masses, config.lengths, config.gravity),
         eigenvector: config.eigenvector,
         chart: Settings::paper(variant).chart,
     })
@@ -161,8 +156,8 @@ pub extern "C" fn eigenmpc_config_default(variant: i32) -> EigenMpcConfig {
         tau_max: s.tau_max,
         horizon: s.horizon as u32,
         sample_period: s.sample_period,
-        masses: s.model.masses,
-        lengths: s.model.lengths,
+        masses: s.model.links.map(|l| l.mass),
+        lengths: s.model.links.map(|l| l.length),
         gravity: s.model.gravity,
         eigenvector: s.eigenvector,
         qp_solver: crate::qp_solver_item(s.qp),

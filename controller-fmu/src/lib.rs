@@ -251,12 +251,11 @@ fn settings(values: &Values) -> Result<Settings, String> {
         tau_max: values.real(VR_TAU_MAX),
         horizon: values.integer(VR_HORIZON) as usize,
         sample_period: values.real(VR_SAMPLE_PERIOD),
-        model: PlanarChainParams {
-            masses: [values.real(VR_M1), values.real(VR_M2)],
-            lengths: [values.real(VR_L1), values.real(VR_L2)],
-            gravity: values.real(VR_G),
-            ..Default::default()
-        },
+        model: PlanarChainParams::point_masses(
+            [values.real(VR_M1), values.real(VR_M2)],
+            [values.real(VR_L1), values.real(VR_L2)],
+            values.real(VR_G),
+        ),
         eigenvector: [values.real(VR_C1), values.real(VR_C2)],
         chart,
     })
@@ -456,7 +455,7 @@ impl Model for EigenMpcFmu {
         for (j, vr) in [(1, VR_M1), (2, VR_M2)] {
             variables.push(
                 Variable::real(format!("m[{j}]"), vr)
-                    .parameter(r(model.masses[j - 1]))
+                    .parameter(r(model.links[j - 1].mass))
                     .unit("kg")
                     .min(1e-6)
                     .max(1e6)
@@ -468,7 +467,7 @@ impl Model for EigenMpcFmu {
         for (j, vr) in [(1, VR_L1), (2, VR_L2)] {
             variables.push(
                 Variable::real(format!("l[{j}]"), vr)
-                    .parameter(r(model.lengths[j - 1]))
+                    .parameter(r(model.links[j - 1].length))
                     .unit("m")
                     .min(1e-6)
                     .max(1e3)

@@ -148,7 +148,7 @@ impl Model for DoublePendulumFmu {
         for (j, vr) in [(1, VR_M1), (2, VR_M2)] {
             variables.push(
                 Variable::real(format!("m[{j}]"), vr)
-                    .parameter(r(defaults.masses[j - 1]))
+                    .parameter(r(defaults.links[j - 1].mass))
                     .unit("kg")
                     .min(1e-6)
                     .max(1e6)
@@ -158,7 +158,7 @@ impl Model for DoublePendulumFmu {
         for (j, vr) in [(1, VR_L1), (2, VR_L2)] {
             variables.push(
                 Variable::real(format!("l[{j}]"), vr)
-                    .parameter(r(defaults.lengths[j - 1]))
+                    .parameter(r(defaults.links[j - 1].length))
                     .unit("m")
                     .min(1e-6)
                     .max(1e3)
@@ -176,7 +176,7 @@ impl Model for DoublePendulumFmu {
         for (j, vr) in [(1, VR_DAMPING1), (2, VR_DAMPING2)] {
             variables.push(
                 Variable::real(format!("damping[{j}]"), vr)
-                    .parameter(r(defaults.damping[j - 1]))
+                    .parameter(r(defaults.joints[j - 1].viscous))
                     .unit("N.m.s/rad")
                     .min(0.0)
                     .max(1e6)
@@ -235,13 +235,13 @@ impl Model for DoublePendulumFmu {
     }
 
     fn initialize(values: &mut Values, ctx: &Context) -> Result<Self, ModelError> {
-        let params = PlanarChainParams {
-            masses: [values.real(VR_M1), values.real(VR_M2)],
-            lengths: [values.real(VR_L1), values.real(VR_L2)],
-            gravity: values.real(VR_G),
-            stiffness: [0.0; 2],
-            damping: [values.real(VR_DAMPING1), values.real(VR_DAMPING2)],
-        };
+        let mut params = PlanarChainParams::point_masses(
+            [values.real(VR_M1), values.real(VR_M2)],
+            [values.real(VR_L1), values.real(VR_L2)],
+            values.real(VR_G),
+        );
+        params.joints[0].viscous = values.real(VR_DAMPING1);
+        params.joints[1].viscous = values.real(VR_DAMPING2);
         let system = DoublePendulum::new(params)
             .map_err(|e| ModelError::Error(format!("invalid pendulum parameters: {e}")))?;
         let q = Vector::<2>::new(values.real(VR_Q0_1), values.real(VR_Q0_2));

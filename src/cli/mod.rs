@@ -59,12 +59,11 @@ pub struct ModelJson {
 impl ModelArgs {
     /// Builds the pendulum, refusing non-physical parameters.
     pub fn pendulum(&self) -> anyhow::Result<DoublePendulum> {
-        Ok(DoublePendulum::new(PlanarChainParams {
-            masses: [self.m1, self.m2],
-            lengths: [self.l1, self.l2],
-            gravity: self.g,
-            ..Default::default()
-        })?)
+        Ok(DoublePendulum::new(PlanarChainParams::point_masses(
+            [self.m1, self.m2],
+            [self.l1, self.l2],
+            self.g,
+        ))?)
     }
 
     /// The JSON description of the model.

@@ -1,42 +1,153 @@
-//! Planar serial chain of `N` links with point masses at the link tips,
-//! relative joint angles, gravity along `-y`, optional joint springs and
-//! viscous joint damping. `N = 2` is the paper's double pendulum (section V).
+//! Planar serial chain of `N` rigid links with geared joint motors, joint
+//! friction and optional joint springs; relative joint angles, gravity along
+//! `-y`. The paper's double pendulum (section V) is the 2-link chain with
+//! point masses at the link tips ([`PlanarChainParams::point_masses`]).
 //!
 //! The closed form works in absolute link angles `phi = L theta` (`L` lower
-//! triangular ones) where the inertia is `Mt_jl = mu_max(j,l) l_j l_l
-//! cos(phi_j - phi_l)` with `mu_j` the mass carried by link `j`; relative
-//! quantities follow by `M = L' Mt L`. All derivatives are exact.
+//! triangular ones) where the link inertia is `Mt_jl = A_jl cos(phi_j -
+//! phi_l)` with constant amplitudes `A` (masses, lengths, centre-of-mass
+//! distances and link inertias), plus the constant inertia the motor rotors
+//! add; relative quantities follow by `M = L' Mt L`. All derivatives are
+//! exact.
+//!
+//! Motors (as the identified laboratory pendulums of `shared/robots`): joint
+//! `j`'s rotor (inertia `Ir_j` before a gearbox of ratio `gr_j`) sits on link
+//! `j - 1` (the base for `j = 1`) and turns at `phid_{j-1} - gr_j qd_j`, so it
+//! adds `Ir_j w_j w_j'` to `M` with `w_j = sum_{i<j} e_i - gr_j e_j`: for two
+//! joints `M11 += gr1^2 Ir1 + Ir2`, `M12 += -gr2 Ir2`, `M22 += gr2^2 Ir2`.
+//!
+//! Friction per joint: viscous `b qd` plus the smooth Coulomb law
+//! `cf atan(k qd)` (`k` = [`PlanarChainParams::coulomb_sharpness`], 100 1/(rad/s)
+//! in the shared parameter files; it tends to `cf pi/2` at speed).
 
 use super::{DynamicsJacobian, Matrix, MechanicalSystem, Vector};
 use thiserror::Error;
 
-/// Physical parameters of a [`PlanarChain`].
+/// One rigid link.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PlanarChainParams<const N: usize> {
-    /// Tip masses `m_j` (kg).
-    pub masses: [f64; N],
-    /// Link lengths `l_j` (m).
-    pub lengths: [f64; N],
-    /// Gravitational acceleration `g` (m/s^2).
-    pub gravity: f64,
-    /// Joint spring stiffness (N m / rad), rest at zero angle.
-    pub stiffness: [f64; N],
-    /// Viscous joint damping (N m s / rad).
-    pub damping: [f64; N],
+pub struct Link {
+    /// Mass `m` (kg).
+    pub mass: f64,
+    /// Length `l`, joint to next joint (m). The last link's length does not
+    /// enter the dynamics.
+    pub length: f64,
+    /// Distance `r` from the link's joint to its centre of mass along the link (m).
+    pub com: f64,
+    /// Inertia **about the centre of mass** (kg m^2). The inertia about the
+    /// joint axis is `inertia + mass com^2` ([`Link::inertia_about_joint`]).
+    pub inertia: f64,
 }
 
-impl<const N: usize> Default for PlanarChainParams<N> {
-    /// The paper's values: 1 kg, 1 m, g = 9.81, no springs, no damping.
+impl Link {
+    /// A point mass at the link tip (the paper's model): `r = l`, no inertia about the COM.
+    pub fn point_mass(mass: f64, length: f64) -> Self {
+        Self {
+            mass,
+            length,
+            com: length,
+            inertia: 0.0,
+        }
+    }
+
+    /// A rigid link given, as identified robots usually are, by its inertia
+    /// **about the joint axis** `I = I_com + m r^2` (converted to `I_com`).
+    pub fn with_inertia_about_joint(mass: f64, length: f64, com: f64, inertia: f64) -> Self {
+        Self {
+            mass,
+            length,
+            com,
+            inertia: inertia - mass * com * com,
+        }
+    }
+
+    /// Inertia about the joint axis, `I_com + m r^2` (kg m^2).
+    pub fn inertia_about_joint(&self) -> f64 {
+        self.inertia + self.mass * self.com * self.com
+    }
+}
+
+/// One actuated joint: motor, friction and an optional spring.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Joint {
+    /// Rotor inertia of the joint's motor before the gearbox, `Ir` (kg m^2).
+    pub rotor_inertia: f64,
+    /// Gear ratio `gr` (motor turns per joint turn, > 0).
+    pub gear_ratio: f64,
+    /// Viscous friction `b` (N m s/rad).
+    pub viscous: f64,
+    /// Coulomb friction `cf` (N m) of the law `cf atan(k qd)`.
+    pub coulomb: f64,
+    /// Spring stiffness (N m/rad); zero: no spring.
+    pub stiffness: f64,
+    /// Spring rest angle (rad).
+    pub rest_angle: f64,
+}
+
+impl Default for Joint {
+    /// A frictionless direct drive without rotor inertia or spring.
     fn default() -> Self {
         Self {
-            masses: [1.0; N],
-            lengths: [1.0; N],
-            gravity: 9.81,
-            stiffness: [0.0; N],
-            damping: [0.0; N],
+            rotor_inertia: 0.0,
+            gear_ratio: 1.0,
+            viscous: 0.0,
+            coulomb: 0.0,
+            stiffness: 0.0,
+            rest_angle: 0.0,
         }
     }
 }
+
+/// Physical parameters of a [`PlanarChain`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlanarChainParams<const N: usize> {
+    /// Links, from the base outwards.
+    pub links: [Link; N],
+    /// Joints; joint `j` drives link `j` and its motor sits on link `j - 1`.
+    pub joints: [Joint; N],
+    /// Gravitational acceleration `g` (m/s^2).
+    pub gravity: f64,
+    /// Slope `k` of the smooth Coulomb law `cf atan(k qd)` (s/rad).
+    pub coulomb_sharpness: f64,
+}
+
+impl<const N: usize> Default for PlanarChainParams<N> {
+    /// The paper's values: 1 kg point masses at the tips of 1 m links,
+    /// g = 9.81, frictionless direct drives, no springs.
+    fn default() -> Self {
+        Self::point_masses([1.0; N], [1.0; N], 9.81)
+    }
+}
+
+impl<const N: usize> PlanarChainParams<N> {
+    /// Point masses at the link tips, frictionless direct drives (the paper's model).
+    pub fn point_masses(masses: [f64; N], lengths: [f64; N], gravity: f64) -> Self {
+        Self {
+            links: std::array::from_fn(|j| Link::point_mass(masses[j], lengths[j])),
+            joints: [Joint::default(); N],
+            gravity,
+            coulomb_sharpness: DEFAULT_COULOMB_SHARPNESS,
+        }
+    }
+
+    /// The same chain with viscous and Coulomb friction removed.
+    pub fn without_friction(mut self) -> Self {
+        for j in &mut self.joints {
+            j.viscous = 0.0;
+            j.coulomb = 0.0;
+        }
+        self
+    }
+
+    /// True when some joint has viscous or Coulomb friction.
+    pub fn has_friction(&self) -> bool {
+        self.joints
+            .iter()
+            .any(|j| j.viscous > 0.0 || j.coulomb > 0.0)
+    }
+}
+
+/// Slope `k` of `cf atan(k qd)` the shared robot files were identified with (s/rad).
+pub const DEFAULT_COULOMB_SHARPNESS: f64 = 100.0;
 
 /// Why a set of chain parameters was refused.
 #[derive(Debug, Error, Clone, PartialEq)]
@@ -51,19 +162,27 @@ pub enum ParamsError {
         /// What range was expected.
         reason: &'static str,
     },
-    /// Neither gravity nor springs hold the chain: no stable equilibrium.
-    #[error("no stable equilibrium: gravity and all joint springs are zero")]
-    NoEquilibrium,
+    /// Gravity and springs do not hold the chain at a strict minimum of the potential.
+    #[error("no stable equilibrium: {0}")]
+    NoEquilibrium(String),
 }
 
-/// A planar serial chain with point masses at the link tips.
+/// A planar serial chain of rigid links with geared motors and joint friction.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PlanarChain<const N: usize> {
     params: PlanarChainParams<N>,
-    /// `a_jl = mu_max(j,l) l_j l_l`, the amplitudes of the absolute inertia.
+    /// `A_jl`, the amplitudes of the absolute link inertia `A_jl cos(phi_j - phi_l)`.
     coupling: Matrix<N>,
-    /// `g mu_j l_j`, the amplitudes of the gravity torques on absolute angles.
+    /// Constant inertia of the motor rotors in absolute angles, `L^-T M_r L^-1`.
+    rotor_absolute: Matrix<N>,
+    /// Constant inertia of the motor rotors in joint angles, `M_r`.
+    rotor_joint: Matrix<N>,
+    /// `g (m_j r_j + l_j sum_{i>j} m_i)`, the amplitudes of the gravity torques on absolute angles.
     gravity_amplitude: Vector<N>,
+    /// The stable equilibrium `q_eq` (zero unless springs have rest angles).
+    equilibrium: Vector<N>,
+    /// Gravity and spring energy at `q_eq`, subtracted so that `V(q_eq) = 0`.
+    potential_offset: f64,
 }
 
 /// The paper's double pendulum: `theta_1` absolute, `theta_2` relative.
@@ -93,33 +212,158 @@ fn check(name: String, value: f64, positive: bool) -> Result<(), ParamsError> {
 }
 
 impl<const N: usize> PlanarChain<N> {
-    /// Builds the chain, refusing non-physical parameters.
+    /// Builds the chain, refusing non-physical parameters (the message
+    /// names the parameter: `m1`, `r2`, `I1`, `Ir2`, `gr1`, `b1`, `cf2`, ...).
     pub fn new(params: PlanarChainParams<N>) -> Result<Self, ParamsError> {
-        for j in 0..N {
-            check(format!("m{}", j + 1), params.masses[j], true)?;
-            check(format!("l{}", j + 1), params.lengths[j], true)?;
-            check(format!("stiffness{}", j + 1), params.stiffness[j], false)?;
-            check(format!("damping{}", j + 1), params.damping[j], false)?;
+        for (j, link) in params.links.iter().enumerate() {
+            let n = j + 1;
+            check(format!("m{n}"), link.mass, true)?;
+            check(format!("l{n}"), link.length, true)?;
+            if !link.com.is_finite() {
+                return Err(ParamsError::Invalid {
+                    name: format!("r{n}"),
+                    value: link.com,
+                    reason: "must be finite",
+                });
+            }
+            if !(link.inertia.is_finite()
+                && link.inertia >= -1e-12 * link.inertia_about_joint().abs())
+            {
+                return Err(ParamsError::Invalid {
+                    name: format!("I{n}"),
+                    value: link.inertia_about_joint(),
+                    reason: "the inertia about the joint must be finite and >= m r^2 (inertia about the centre of mass >= 0)",
+                });
+            }
+            if link.inertia_about_joint() <= 0.0 {
+                return Err(ParamsError::Invalid {
+                    name: format!("I{n}"),
+                    value: link.inertia_about_joint(),
+                    reason: "the link has no inertia about its joint (a point mass on the axis)",
+                });
+            }
+        }
+        for (j, joint) in params.joints.iter().enumerate() {
+            let n = j + 1;
+            check(format!("Ir{n}"), joint.rotor_inertia, false)?;
+            check(format!("gr{n}"), joint.gear_ratio, true)?;
+            check(format!("b{n}"), joint.viscous, false)?;
+            check(format!("cf{n}"), joint.coulomb, false)?;
+            check(format!("k{n}"), joint.stiffness, false)?;
+            if !joint.rest_angle.is_finite() {
+                return Err(ParamsError::Invalid {
+                    name: format!("q_rest{n}"),
+                    value: joint.rest_angle,
+                    reason: "must be finite",
+                });
+            }
         }
         check("g".into(), params.gravity, false)?;
-        if params.gravity == 0.0 && params.stiffness.contains(&0.0) {
-            return Err(ParamsError::NoEquilibrium);
+        check("coulomb_sharpness".into(), params.coulomb_sharpness, true)?;
+
+        let links = &params.links;
+        // Lever arm of link j's length or COM in the position of link i's COM.
+        let arm = |j: usize, i: usize| {
+            if j < i {
+                links[j].length
+            } else if j == i {
+                links[j].com
+            } else {
+                0.0
+            }
+        };
+        let coupling = Matrix::<N>::from_fn(|j, l| {
+            let translation: f64 = (j.max(l)..N)
+                .map(|i| links[i].mass * arm(j, i) * arm(l, i))
+                .sum();
+            translation + if j == l { links[j].inertia } else { 0.0 }
+        });
+        let gravity_amplitude = Vector::<N>::from_fn(|j, _| {
+            let carried: f64 = links[j + 1..].iter().map(|l| l.mass).sum();
+            params.gravity * (links[j].mass * links[j].com + carried * links[j].length)
+        });
+        let mut rotor_joint = Matrix::<N>::zeros();
+        for (j, joint) in params.joints.iter().enumerate() {
+            let w = Vector::<N>::from_fn(|i, _| {
+                if i < j {
+                    1.0
+                } else if i == j {
+                    -joint.gear_ratio
+                } else {
+                    0.0
+                }
+            });
+            rotor_joint += w * w.transpose() * joint.rotor_inertia;
         }
-        let carried = |j: usize| params.masses[j..].iter().sum::<f64>();
-        let coupling =
-            Matrix::<N>::from_fn(|j, l| carried(j.max(l)) * params.lengths[j] * params.lengths[l]);
-        let gravity_amplitude =
-            Vector::<N>::from_fn(|j, _| params.gravity * carried(j) * params.lengths[j]);
-        Ok(Self {
+        let l_inv = Self::l_inverse();
+        let rotor_absolute = l_inv.transpose() * rotor_joint * l_inv;
+        let mut chain = Self {
             params,
             coupling,
+            rotor_absolute,
+            rotor_joint,
             gravity_amplitude,
-        })
+            equilibrium: Vector::<N>::zeros(),
+            potential_offset: 0.0,
+        };
+        chain.equilibrium = chain.find_equilibrium()?;
+        chain.potential_offset = chain.raw_potential(&chain.equilibrium);
+        if chain
+            .potential_hessian(&chain.equilibrium)
+            .cholesky()
+            .is_none()
+        {
+            return Err(ParamsError::NoEquilibrium(format!(
+                "the potential's Hessian at q_eq = {:?} is not positive definite \
+                 (gravity and joint springs do not hold the chain)",
+                chain.equilibrium.as_slice()
+            )));
+        }
+        Ok(chain)
     }
 
     /// The parameters the chain was built from.
     pub fn params(&self) -> &PlanarChainParams<N> {
         &self.params
+    }
+
+    /// The same chain with another Coulomb slope `k` (e.g. a smoother law
+    /// for a prediction model with long integration steps).
+    pub fn with_coulomb_sharpness(&self, k: f64) -> Result<Self, ParamsError> {
+        Self::new(PlanarChainParams {
+            coulomb_sharpness: k,
+            ..self.params
+        })
+    }
+
+    /// Stable equilibrium: `q = 0` unless a spring has a rest angle, then
+    /// Newton on `dV/dq = 0` from the rest angles' hanging configuration.
+    fn find_equilibrium(&self) -> Result<Vector<N>, ParamsError> {
+        if self
+            .params
+            .joints
+            .iter()
+            .all(|j| j.rest_angle == 0.0 || j.stiffness == 0.0)
+        {
+            return Ok(Vector::<N>::zeros());
+        }
+        let mut q = Vector::<N>::zeros();
+        for _ in 0..100 {
+            let g = self.potential_gradient(&q);
+            if g.amax() < 1e-13 {
+                return Ok(q);
+            }
+            let step = match self.potential_hessian(&q).cholesky() {
+                Some(ch) => ch.solve(&g),
+                None => break,
+            };
+            // Damped Newton: never more than 0.5 rad per iteration.
+            let scale = (0.5 / step.amax().max(1e-300)).min(1.0);
+            q -= step * scale;
+        }
+        Err(ParamsError::NoEquilibrium(
+            "Newton on dV/dq = 0 from the hanging configuration did not converge".into(),
+        ))
     }
 
     /// Absolute link angles `phi = L theta`.
@@ -159,9 +403,10 @@ impl<const N: usize> PlanarChain<N> {
         })
     }
 
-    /// Inertia in absolute angles `Mt(phi)`.
+    /// Inertia in absolute angles `Mt(phi)`, rotors included.
     fn absolute_mass_matrix(&self, phi: &Vector<N>) -> Matrix<N> {
         Matrix::<N>::from_fn(|j, l| self.coupling[(j, l)] * (phi[j] - phi[l]).cos())
+            + self.rotor_absolute
     }
 
     /// Centrifugal forces in absolute angles `h_j = sum_l a_jl sin(phi_j - phi_l) phid_l^2`.
@@ -174,25 +419,43 @@ impl<const N: usize> PlanarChain<N> {
     }
 
     fn spring_forces(&self, q: &Vector<N>) -> Vector<N> {
-        Vector::<N>::from_fn(|j, _| self.params.stiffness[j] * q[j])
-    }
-}
-
-impl<const N: usize> MechanicalSystem<N> for PlanarChain<N> {
-    fn mass_matrix(&self, q: &Vector<N>) -> Matrix<N> {
-        let l = Self::l_matrix();
-        l.transpose() * self.absolute_mass_matrix(&Self::absolute(q)) * l
+        Vector::<N>::from_fn(|j, _| {
+            let joint = &self.params.joints[j];
+            joint.stiffness * (q[j] - joint.rest_angle)
+        })
     }
 
-    fn potential(&self, q: &Vector<N>) -> f64 {
+    fn stiffness(&self) -> Vector<N> {
+        Vector::<N>::from_fn(|j, _| self.params.joints[j].stiffness)
+    }
+
+    /// Gravity and spring energy before the offset that puts `V(q_eq) = 0`.
+    fn raw_potential(&self, q: &Vector<N>) -> f64 {
         let phi = Self::absolute(q);
         let gravity: f64 = (0..N)
             .map(|j| self.gravity_amplitude[j] * (1.0 - phi[j].cos()))
             .sum();
         let springs: f64 = (0..N)
-            .map(|j| 0.5 * self.params.stiffness[j] * q[j] * q[j])
+            .map(|j| {
+                let joint = &self.params.joints[j];
+                let d = q[j] - joint.rest_angle;
+                0.5 * joint.stiffness * d * d
+            })
             .sum();
         gravity + springs
+    }
+}
+
+impl<const N: usize> MechanicalSystem<N> for PlanarChain<N> {
+    fn mass_matrix(&self, q: &Vector<N>) -> Matrix<N> {
+        let phi = Self::absolute(q);
+        let l = Self::l_matrix();
+        let links = Matrix::<N>::from_fn(|j, m| self.coupling[(j, m)] * (phi[j] - phi[m]).cos());
+        l.transpose() * links * l + self.rotor_joint
+    }
+
+    fn potential(&self, q: &Vector<N>) -> f64 {
+        self.raw_potential(q) - self.potential_offset
     }
 
     fn potential_gradient(&self, q: &Vector<N>) -> Vector<N> {
@@ -205,8 +468,8 @@ impl<const N: usize> MechanicalSystem<N> for PlanarChain<N> {
         let phi = Self::absolute(q);
         let l = Self::l_matrix();
         let diag = Vector::<N>::from_fn(|j, _| self.gravity_amplitude[j] * phi[j].cos());
-        let springs = Vector::<N>::from(self.params.stiffness);
-        l.transpose() * Matrix::<N>::from_diagonal(&diag) * l + Matrix::<N>::from_diagonal(&springs)
+        l.transpose() * Matrix::<N>::from_diagonal(&diag) * l
+            + Matrix::<N>::from_diagonal(&self.stiffness())
     }
 
     fn coriolis_forces(&self, q: &Vector<N>, qd: &Vector<N>) -> Vector<N> {
@@ -215,20 +478,38 @@ impl<const N: usize> MechanicalSystem<N> for PlanarChain<N> {
         Self::to_joint_forces(&self.absolute_centrifugal(&phi, &phid))
     }
 
-    fn damping(&self) -> Vector<N> {
-        Vector::<N>::from(self.params.damping)
-    }
-
     fn equilibrium(&self) -> Vector<N> {
-        Vector::<N>::zeros()
+        self.equilibrium
     }
 
-    fn forward_dynamics(&self, q: &Vector<N>, qd: &Vector<N>, tau: &Vector<N>) -> Vector<N> {
-        // Solve in absolute angles, Mt phidd = L^-T (tau - D qd - K q) - h - G,
+    fn friction(&self, qd: &Vector<N>) -> Vector<N> {
+        let k = self.params.coulomb_sharpness;
+        Vector::<N>::from_fn(|j, _| {
+            let joint = &self.params.joints[j];
+            joint.viscous * qd[j] + joint.coulomb * (k * qd[j]).atan()
+        })
+    }
+
+    fn friction_slope(&self, qd: &Vector<N>) -> Vector<N> {
+        let k = self.params.coulomb_sharpness;
+        Vector::<N>::from_fn(|j, _| {
+            let joint = &self.params.joints[j];
+            let kv = k * qd[j];
+            joint.viscous + joint.coulomb * k / (1.0 + kv * kv)
+        })
+    }
+
+    fn conservative_forward_dynamics(
+        &self,
+        q: &Vector<N>,
+        qd: &Vector<N>,
+        tau: &Vector<N>,
+    ) -> Vector<N> {
+        // Solve in absolute angles, Mt phidd = L^-T (tau - K (q - q_rest)) - h - G,
         // which avoids forming L' Mt L.
         let phi = Self::absolute(q);
         let phid = Self::absolute(qd);
-        let joint = tau - self.damping().component_mul(qd) - self.spring_forces(q);
+        let joint = tau - self.spring_forces(q);
         let w = Self::to_absolute_forces(&joint)
             - self.absolute_centrifugal(&phi, &phid)
             - Vector::<N>::from_fn(|j, _| self.gravity_amplitude[j] * phi[j].sin());
@@ -236,7 +517,7 @@ impl<const N: usize> MechanicalSystem<N> for PlanarChain<N> {
         Self::l_inverse() * phidd
     }
 
-    fn dynamics_jacobian(
+    fn conservative_dynamics_jacobian(
         &self,
         q: &Vector<N>,
         qd: &Vector<N>,
@@ -247,11 +528,11 @@ impl<const N: usize> MechanicalSystem<N> for PlanarChain<N> {
         let a = &self.coupling;
         let sin = Matrix::<N>::from_fn(|j, l| (phi[j] - phi[l]).sin());
         let cos = Matrix::<N>::from_fn(|j, l| (phi[j] - phi[l]).cos());
-        let mt = a.component_mul(&cos);
+        let a_cos = a.component_mul(&cos);
         let a_sin = a.component_mul(&sin);
-        let a_cos = mt;
+        let mt = a_cos + self.rotor_absolute;
 
-        let joint = tau - self.damping().component_mul(qd) - self.spring_forces(q);
+        let joint = tau - self.spring_forces(q);
         let centrifugal = a_sin * phid.component_mul(&phid);
         let gravity = Vector::<N>::from_fn(|j, _| self.gravity_amplitude[j] * phi[j].sin());
         let w = Self::to_absolute_forces(&joint) - centrifugal - gravity;
@@ -268,6 +549,7 @@ impl<const N: usize> MechanicalSystem<N> for PlanarChain<N> {
 
         let phid_sq = phid.component_mul(&phid);
         // d(Mt phidd)/d phi: -diag(sum_l a_jl s_jl phidd_l) + a_jk s_jk phidd_k
+        // (the rotor inertia is constant and drops out).
         let row_mass = a_sin * phidd;
         let d_mass = Matrix::<N>::from_fn(|j, k| {
             let diag = if j == k { -row_mass[j] } else { 0.0 };
@@ -287,11 +569,10 @@ impl<const N: usize> MechanicalSystem<N> for PlanarChain<N> {
         let l = Self::l_matrix();
         let l_inv = Self::l_inverse();
         let l_inv_t = l_inv.transpose();
-        let springs = Matrix::<N>::from_diagonal(&Vector::<N>::from(self.params.stiffness));
-        let damping = Matrix::<N>::from_diagonal(&self.damping());
+        let springs = Matrix::<N>::from_diagonal(&self.stiffness());
 
         let dw_dq = (-d_cent_phi - d_grav - d_mass) * l - l_inv_t * springs;
-        let dw_dqd = -d_cent_phid * l - l_inv_t * damping;
+        let dw_dqd = -d_cent_phid * l;
 
         DynamicsJacobian {
             acceleration: l_inv * phidd,
@@ -323,11 +604,11 @@ mod tests {
 
     #[test]
     fn mass_matrix_matches_paper_formula() {
-        let p = PlanarChain::<2>::new(PlanarChainParams {
-            masses: [1.3, 0.7],
-            lengths: [0.9, 1.2],
-            ..Default::default()
-        })
+        let p = PlanarChain::<2>::new(PlanarChainParams::point_masses(
+            [1.3, 0.7],
+            [0.9, 1.2],
+            9.81,
+        ))
         .unwrap();
         let (m1, m2, l1, l2): (f64, f64, f64, f64) = (1.3, 0.7, 0.9, 1.2);
         for &t2 in &[0.0, 0.4, -1.7, 3.0] {
@@ -355,24 +636,15 @@ mod tests {
 
     #[test]
     fn refuses_bad_parameters() {
-        let bad = PlanarChainParams::<2> {
-            masses: [-1.0, 1.0],
-            ..Default::default()
-        };
+        let bad = PlanarChainParams::<2>::point_masses([-1.0, 1.0], [1.0; 2], 9.81);
         let err = DoublePendulum::new(bad).unwrap_err();
         assert!(err.to_string().contains("m1"), "{err}");
-        let nan = PlanarChainParams::<2> {
-            gravity: f64::NAN,
-            ..Default::default()
-        };
+        let nan = PlanarChainParams::<2>::point_masses([1.0; 2], [1.0; 2], f64::NAN);
         assert!(DoublePendulum::new(nan).is_err());
-        let free = PlanarChainParams::<2> {
-            gravity: 0.0,
-            ..Default::default()
-        };
-        assert_eq!(
+        let free = PlanarChainParams::<2>::point_masses([1.0; 2], [1.0; 2], 0.0);
+        assert!(matches!(
             DoublePendulum::new(free).unwrap_err(),
-            ParamsError::NoEquilibrium
-        );
+            ParamsError::NoEquilibrium(_)
+        ));
     }
 }

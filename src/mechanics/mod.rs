@@ -1,4 +1,4 @@
-//! Simple mechanical systems `M(q) qdd + C(q, qd) qd + dV/dq + D qd = tau`
+//! Simple mechanical systems `M(q) qdd + C(q, qd) qd + dV/dq + tau_f(qd) = tau`
 //! (paper, eq. 2) and their state-space form `z = (q, qd)`.
 //!
 //! The dimension is a const generic `N` (degrees of freedom) so that the
@@ -8,7 +8,7 @@
 
 mod chain;
 
-pub use chain::{DoublePendulum, PlanarChain, PlanarChainParams};
+pub use chain::{DoublePendulum, Joint, Link, ParamsError, PlanarChain, PlanarChainParams};
 
 use nalgebra::{SMatrix, SVector};
 
@@ -30,12 +30,15 @@ pub struct DynamicsJacobian<const N: usize> {
     pub d_tau: Matrix<N>,
 }
 
-/// A simple mechanical system (paper, definition 1) in local coordinates.
+/// A simple mechanical system (paper, definition 1) in local coordinates,
+/// `M(q) qdd + C(q, qd) qd + dV/dq + tau_f(qd) = tau`.
 ///
 /// Implementors provide the inertia, the potential with its first two
 /// derivatives, the Coriolis/centrifugal forces and exact first derivatives of
-/// the forward dynamics and the energy; everything else (energy, state-space
-/// form, linear modes, eigenmodes, NMPC) is built on these.
+/// the conservative forward dynamics and of the energy; joint friction
+/// `tau_f(qd)` (zero by default) is folded in generically, because it enters
+/// only as a torque. Everything else (energy, state-space form, linear modes,
+/// eigenmodes, NMPC) is built on these.
 pub trait MechanicalSystem<const N: usize> {
     /// Inertia matrix `M(q)` (symmetric positive definite).
     fn mass_matrix(&self, q: &Vector<N>) -> Matrix<N>;
@@ -47,12 +50,11 @@ pub trait MechanicalSystem<const N: usize> {
     fn potential_hessian(&self, q: &Vector<N>) -> Matrix<N>;
     /// Coriolis and centrifugal forces `C(q, qd) qd`.
     fn coriolis_forces(&self, q: &Vector<N>, qd: &Vector<N>) -> Vector<N>;
-    /// Diagonal of the viscous joint damping `D` (zero for the free system).
-    fn damping(&self) -> Vector<N>;
     /// The stable equilibrium `q_eq` around which modes are defined.
     fn equilibrium(&self) -> Vector<N>;
-    /// Forward dynamics with exact derivatives w.r.t. `(q, qd, tau)`.
-    fn dynamics_jacobian(
+    /// Conservative forward dynamics (`tau_f = 0`) with exact derivatives
+    /// w.r.t. `(q, qd, tau)`.
+    fn conservative_dynamics_jacobian(
         &self,
         q: &Vector<N>,
         qd: &Vector<N>,
@@ -61,13 +63,58 @@ pub trait MechanicalSystem<const N: usize> {
     /// Exact gradient of the energy: `(dE/dq, dE/dqd)`.
     fn energy_gradient(&self, q: &Vector<N>, qd: &Vector<N>) -> (Vector<N>, Vector<N>);
 
-    /// Forward dynamics `qdd = M^-1 (tau - C qd - dV/dq - D qd)`.
-    fn forward_dynamics(&self, q: &Vector<N>, qd: &Vector<N>, tau: &Vector<N>) -> Vector<N> {
-        let rhs = tau
-            - self.coriolis_forces(q, qd)
-            - self.potential_gradient(q)
-            - self.damping().component_mul(qd);
+    /// Joint friction torques `tau_f(qd)`, opposing the motion (zero for a
+    /// conservative system). Each joint's friction depends on its own speed.
+    fn friction(&self, _qd: &Vector<N>) -> Vector<N> {
+        Vector::<N>::zeros()
+    }
+
+    /// Diagonal of `d tau_f / d qd`.
+    fn friction_slope(&self, _qd: &Vector<N>) -> Vector<N> {
+        Vector::<N>::zeros()
+    }
+
+    /// Power taken by friction, `tau_f(qd)' qd` (>= 0).
+    fn friction_power(&self, qd: &Vector<N>) -> f64 {
+        self.friction(qd).dot(qd)
+    }
+
+    /// Conservative forward dynamics `qdd = M^-1 (tau - C qd - dV/dq)`.
+    fn conservative_forward_dynamics(
+        &self,
+        q: &Vector<N>,
+        qd: &Vector<N>,
+        tau: &Vector<N>,
+    ) -> Vector<N> {
+        let rhs = tau - self.coriolis_forces(q, qd) - self.potential_gradient(q);
         solve_spd(&self.mass_matrix(q), &rhs)
+    }
+
+    /// Forward dynamics `qdd = M^-1 (tau - tau_f(qd) - C qd - dV/dq)`.
+    fn forward_dynamics(&self, q: &Vector<N>, qd: &Vector<N>, tau: &Vector<N>) -> Vector<N> {
+        self.conservative_forward_dynamics(q, qd, &(tau - self.friction(qd)))
+    }
+
+    /// Forward dynamics with exact derivatives w.r.t. `(q, qd, tau)`.
+    ///
+    /// Friction enters as the torque `tau - tau_f(qd)`, so its speed
+    /// derivative is `-M^-1 diag(tau_f')`, i.e. `-d_tau diag(tau_f')`.
+    fn dynamics_jacobian(
+        &self,
+        q: &Vector<N>,
+        qd: &Vector<N>,
+        tau: &Vector<N>,
+    ) -> DynamicsJacobian<N> {
+        let mut jac = self.conservative_dynamics_jacobian(q, qd, &(tau - self.friction(qd)));
+        let slope = self.friction_slope(qd);
+        for j in 0..N {
+            if slope[j] != 0.0 {
+                let column = jac.d_tau.column(j) * slope[j];
+                let mut d = jac.d_qd.column_mut(j);
+                d -= column;
+            }
+        }
+        jac
     }
 
     /// Kinetic energy `1/2 qd' M(q) qd`.
@@ -78,6 +125,57 @@ pub trait MechanicalSystem<const N: usize> {
     /// Total energy `E = 1/2 qd' M(q) qd + V(q)` (paper, eq. 3).
     fn energy(&self, q: &Vector<N>, qd: &Vector<N>) -> f64 {
         self.kinetic_energy(q, qd) + self.potential(q)
+    }
+}
+
+/// The conservative part of a system (friction off): the system whose
+/// eigenmodes EigenMPC follows. Borrows the system; friction reads zero.
+#[derive(Clone, Copy, Debug)]
+pub struct Conservative<'a, S: ?Sized>(pub &'a S);
+
+impl<S, const N: usize> MechanicalSystem<N> for Conservative<'_, S>
+where
+    S: MechanicalSystem<N> + ?Sized,
+{
+    fn mass_matrix(&self, q: &Vector<N>) -> Matrix<N> {
+        self.0.mass_matrix(q)
+    }
+    fn potential(&self, q: &Vector<N>) -> f64 {
+        self.0.potential(q)
+    }
+    fn potential_gradient(&self, q: &Vector<N>) -> Vector<N> {
+        self.0.potential_gradient(q)
+    }
+    fn potential_hessian(&self, q: &Vector<N>) -> Matrix<N> {
+        self.0.potential_hessian(q)
+    }
+    fn coriolis_forces(&self, q: &Vector<N>, qd: &Vector<N>) -> Vector<N> {
+        self.0.coriolis_forces(q, qd)
+    }
+    fn equilibrium(&self) -> Vector<N> {
+        self.0.equilibrium()
+    }
+    fn conservative_dynamics_jacobian(
+        &self,
+        q: &Vector<N>,
+        qd: &Vector<N>,
+        tau: &Vector<N>,
+    ) -> DynamicsJacobian<N> {
+        self.0.conservative_dynamics_jacobian(q, qd, tau)
+    }
+    fn energy_gradient(&self, q: &Vector<N>, qd: &Vector<N>) -> (Vector<N>, Vector<N>) {
+        self.0.energy_gradient(q, qd)
+    }
+    fn conservative_forward_dynamics(
+        &self,
+        q: &Vector<N>,
+        qd: &Vector<N>,
+        tau: &Vector<N>,
+    ) -> Vector<N> {
+        self.0.conservative_forward_dynamics(q, qd, tau)
+    }
+    fn kinetic_energy(&self, q: &Vector<N>, qd: &Vector<N>) -> f64 {
+        self.0.kinetic_energy(q, qd)
     }
 }
 

@@ -10,7 +10,8 @@
 use super::{ModeError, linear_modes};
 use crate::integrate::{Dopri5, Tolerances, Variational, variational_rhs};
 use crate::mechanics::{
-    MechanicalSystem, Vector, pack_state, state_derivative, state_jacobian, unpack_state,
+    Conservative, MechanicalSystem, Vector, pack_state, state_derivative, state_jacobian,
+    unpack_state,
 };
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
@@ -239,6 +240,9 @@ where
     S: MechanicalSystem<N> + ?Sized,
 {
     const { assert!(NX == 2 * N, "NX must equal 2 N") };
+    // Eigenmodes are those of the conservative part: friction off.
+    let conservative = Conservative(system);
+    let system = &conservative;
     if let Some(&bad) = energies.iter().find(|e| !(e.is_finite() && **e > 0.0)) {
         return Err(ModeError::InvalidEnergy(bad));
     }
@@ -272,7 +276,7 @@ where
         reason,
     };
     let first =
-        shoot::<S, N, NX>(system, e_start, guess, opts).map_err(|r| fail(0.0, e_start, r))?;
+        shoot::<_, N, NX>(system, e_start, guess, opts).map_err(|r| fail(0.0, e_start, r))?;
     // History for the secant predictor, parametrised by sqrt(E) (amplitude
     // grows like sqrt(E) near the equilibrium).
     let mut prev: Option<(f64, Shot<N>)> = None;
@@ -294,7 +298,7 @@ where
                 }
                 None => cur.1,
             };
-            match shoot::<S, N, NX>(system, e_next, predicted, opts) {
+            match shoot::<_, N, NX>(system, e_next, predicted, opts) {
                 Ok(shot) if c.dot(&(shot.q0 - q_eq)) > 0.0 => {
                     prev = Some(cur);
                     cur = (e_next, shot);
@@ -318,7 +322,7 @@ where
         }
         // The loop ends exactly on target (steps are clipped to it).
         let shot = cur.1;
-        results[idx] = Some(verify::<S, N, NX>(system, target, &shot, opts)?);
+        results[idx] = Some(verify::<_, N, NX>(system, target, &shot, opts)?);
         progress(done + 1);
     }
     Ok(results
