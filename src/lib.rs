@@ -4,15 +4,19 @@
 //! eigenmanifold-inspired model-predictive control framework for exciting
 //! efficient oscillations in mechanical systems"):
 //!
-//! - [`mechanics`]: simple mechanical systems `M(q) qdd + C qd + dV/dq = tau`,
-//!   the paper's double pendulum as a planar serial chain, energy and exact
-//!   derivatives;
+//! - [`mechanics`]: simple mechanical systems `M(q) qdd + C qd + dV/dq +
+//!   tau_f(qd) = tau`, planar chains of rigid links with geared motors and
+//!   friction (the paper's double pendulum is the point-mass 2-link chain),
+//!   energy and exact derivatives;
+//! - [`model_file`]: robots from JSON/YAML parameter files;
 //! - [`integrate`]: RK4 with sensitivities and adaptive Dormand-Prince 5(4);
 //! - [`modes`]: linear modes, nonlinear eigenmodes (brake orbits) continued in
-//!   energy, and the polynomial mode chart `X(s)`.
+//!   energy, the polynomial mode chart `X(s)` and its family over energy;
+//! - [`mpc`]: the EigenMPC controller (real-time iterations).
 
 pub mod integrate;
 pub mod mechanics;
+pub mod model_file;
 pub mod modes;
 pub mod mpc;
 pub mod qp;

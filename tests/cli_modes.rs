@@ -177,3 +177,89 @@ fn fmu_start_values_carry_the_chart_of_the_requested_mode() {
     assert!(stderr.contains("exactly one energy"), "{stderr}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+fn robot_file(name: &str) -> String {
+    format!("{}/robots/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+#[test]
+fn a_robot_parameter_file_gives_its_modes_and_fmu_start_values() {
+    let a0 = robot_file("lab-double-pendulum-A0.yml");
+    let out = std::env::temp_dir().join(format!("eigenmpc-a0-start-{}.json", std::process::id()));
+    let (code, stdout, stderr) = run(&[
+        "modes",
+        "--model",
+        &a0,
+        "--energies",
+        "2",
+        "--fmu-start-values",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let doc: Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(doc["model"]["kind"], "planar-chain");
+    assert_eq!(doc["model"]["cf1"], 0.093);
+    let m = &doc["modes"][0];
+    assert!(m["closing_error"].as_f64().unwrap() < 1e-9);
+    // A smaller, stiffer pendulum than the paper's: shorter half period.
+    assert!(m["half_period"].as_f64().unwrap() < 1.0);
+    let start: Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    assert_eq!(start["E_ref"], 2.0);
+    assert_eq!(start["gr[2]"], 6.0);
+    assert_eq!(start["I[1]"], 0.053470810264216295);
+    assert_eq!(start["r[2]"], 0.18377686083653508);
+    assert_eq!(start["coulomb_sharpness"], 100.0);
+    std::fs::remove_file(out).ok();
+}
+
+#[test]
+fn a_bad_parameter_file_gives_a_one_line_error_naming_key_and_file() {
+    let dir = std::env::temp_dir().join(format!("eigenmpc-bad-model-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (name, text, needle) in [
+        (
+            "missing.yml",
+            "m1: 1\nm2: 1\nl1: 1\nl2: 1\n",
+            "missing key 'g'",
+        ),
+        (
+            "unknown.yml",
+            "m1: 1\nm2: 1\nl1: 1\nl2: 1\ng: 9.81\nmu: 3\n",
+            "unknown key 'mu'",
+        ),
+        (
+            "negative.json",
+            r#"{"m1":1,"m2":1,"l1":1,"l2":1,"g":9.81,"b2":-1}"#,
+            "key 'b2'",
+        ),
+        (
+            "three.json",
+            r#"{"m1":1,"m2":1,"m3":1,"l1":1,"l2":1,"l3":1,"g":9.81}"#,
+            "3-link",
+        ),
+    ] {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        let (code, _, stderr) = run(&[
+            "modes",
+            "--model",
+            path.to_str().unwrap(),
+            "--energies",
+            "1",
+        ]);
+        assert_eq!(code, 1, "{name}");
+        assert!(
+            stderr.contains(needle) && stderr.contains(name),
+            "{name}: {stderr}"
+        );
+        assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
+    }
+    let (code, _, stderr) = run(&[
+        "modes",
+        "--model",
+        &robot_file("lab-double-pendulum-A0.yml"),
+        "--m1",
+        "2",
+    ]);
+    assert_eq!(code, 2, "clap refuses --m1 with --model: {stderr}");
+}

@@ -267,9 +267,18 @@ fn spring_rest_angles_move_the_equilibrium_and_keep_v_zero_there() {
 #[test]
 fn non_physical_rigid_link_parameters_are_refused_by_name() {
     let mut p = PlanarChainParams::<2>::default();
-    p.links[1] = Link::with_inertia_about_joint(1.0, 1.0, 1.0, 0.5);
+    p.links[1] = Link::with_inertia_about_joint(1.0, 1.0, 1.0, 0.0);
     let err = PlanarChain::new(p).unwrap_err().to_string();
     assert!(err.contains("I2"), "{err}");
+    // Below m r^2 (identified base parameters) is fine while M stays
+    // positive definite; far below it, M(q2 = 0) is singular.
+    p.links[1] = Link::with_inertia_about_joint(1.0, 1.0, 1.0, 0.9);
+    assert!(PlanarChain::new(p).is_ok());
+    let mut p = PlanarChainParams::<2>::default();
+    p.links[0] = Link::with_inertia_about_joint(1.0, 1.0, 0.9, 0.01);
+    p.links[1] = Link::with_inertia_about_joint(3.0, 1.0, 1.0, 0.05);
+    let err = PlanarChain::new(p).unwrap_err().to_string();
+    assert!(err.contains("not positive definite"), "{err}");
     let mut p = PlanarChainParams::<2>::default();
     p.joints[0].coulomb = -0.1;
     assert!(PlanarChain::new(p).unwrap_err().to_string().contains("cf1"));

@@ -4,9 +4,9 @@
 //! bounded, so a regression on either side fails.
 
 use eigenmpc::mechanics::DoublePendulum;
-use eigenmpc::modes::linear_modes;
+use eigenmpc::modes::{ChartFamily, FamilyOptions, linear_modes};
 use eigenmpc::mpc::closed_loop::mode_and_chart;
-use eigenmpc::mpc::{Controller, MpcConfig, QpBackend, Reference};
+use eigenmpc::mpc::{Controller, MpcConfig, QpBackend, Reference, Variant};
 use eigenmpc::qp::clarabel::{ClarabelQpSolver, rti_settings};
 use eigenmpc::qp::{OcpQp, QpSolution, QpSolver, QpStatus};
 use nalgebra::SVector;
@@ -130,4 +130,22 @@ fn control_steps_do_not_allocate() {
             "{variant}: riccati controller allocated {total} times"
         );
     }
+
+    // A curved controller on a mode family: a tuned E_ref rewrites the
+    // chart in place, without allocating.
+    let family = ChartFamily::compute::<_, 4>(&sys, 0, &FamilyOptions::up_to(20.0)).unwrap();
+    let mut config = MpcConfig::paper(Variant::Curved);
+    config.horizon = 40;
+    let mut ctrl = Controller::<_, 2, 4>::with_family(sys, config, family).unwrap();
+    let mut z = SVector::<f64, 4>::new(0.3, 0.2, 0.0, 0.0);
+    z = eigenmpc::integrate::rk4_step::<_, 2, 4>(&sys, &z, &ctrl.step(&z).tau, 0.025);
+    let before = OURS.load(Ordering::SeqCst) + BACKEND.load(Ordering::SeqCst);
+    for k in 0..50 {
+        ctrl.set_e_ref(8.0 + 0.1 * k as f64).unwrap();
+        let out = ctrl.step(&z);
+        assert!(out.status.is_ok());
+        z = eigenmpc::integrate::rk4_step::<_, 2, 4>(&sys, &z, &out.tau, 0.025);
+    }
+    let total = OURS.load(Ordering::SeqCst) + BACKEND.load(Ordering::SeqCst) - before;
+    assert_eq!(total, 0, "family controller allocated {total} times");
 }

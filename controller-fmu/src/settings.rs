@@ -109,6 +109,7 @@ impl Tuning {
                 velocity: self.w_xd,
                 torque: self.w_f,
             },
+            compensate_friction: true,
         }
     }
 }

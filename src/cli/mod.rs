@@ -6,7 +6,8 @@ mod simulate;
 
 use clap::{Args, Parser, Subcommand};
 use eigenmpc::mechanics::{DoublePendulum, PlanarChainParams};
-use serde::Serialize;
+use eigenmpc::model_file::RobotFile;
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// EigenMPC: eigenmodes and eigenmanifold-inspired NMPC for the double pendulum.
@@ -22,60 +23,150 @@ enum Command {
     /// Compute nonlinear eigenmodes (brake orbits) and their charts; prints JSON.
     Modes(modes::ModesArgs),
     /// Closed loop of the EigenMPC controller against the accurate plant; prints a summary.
-    Simulate(simulate::SimulateArgs),
+    Simulate(Box<simulate::SimulateArgs>),
 }
 
-/// Parameters of the double pendulum (paper, section V).
-#[derive(Args, Debug, Clone, Copy)]
+/// The robot: a parameter file, or the paper's point-mass double pendulum
+/// with the given masses and lengths.
+#[derive(Args, Debug, Clone)]
 pub struct ModelArgs {
+    /// Robot parameter file (JSON or YAML, flat keys m1 m2 l1 l2 r1 r2 I1 I2 Ir gr b1 b2 cf1
+    /// cf2 g ...; see README "Robots from a parameter file"). Replaces --m1 .. --g.
+    #[arg(long, value_name = "FILE")]
+    pub model: Option<PathBuf>,
     /// Mass at the tip of link 1 (kg).
-    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    #[arg(
+        long,
+        default_value_t = 1.0,
+        allow_negative_numbers = true,
+        conflicts_with = "model"
+    )]
     pub m1: f64,
     /// Mass at the tip of link 2 (kg).
-    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    #[arg(
+        long,
+        default_value_t = 1.0,
+        allow_negative_numbers = true,
+        conflicts_with = "model"
+    )]
     pub m2: f64,
     /// Length of link 1 (m).
-    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    #[arg(
+        long,
+        default_value_t = 1.0,
+        allow_negative_numbers = true,
+        conflicts_with = "model"
+    )]
     pub l1: f64,
     /// Length of link 2 (m).
-    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    #[arg(
+        long,
+        default_value_t = 1.0,
+        allow_negative_numbers = true,
+        conflicts_with = "model"
+    )]
     pub l2: f64,
     /// Gravitational acceleration (m/s^2).
-    #[arg(long, default_value_t = 9.81, allow_negative_numbers = true)]
+    #[arg(
+        long,
+        default_value_t = 9.81,
+        allow_negative_numbers = true,
+        conflicts_with = "model"
+    )]
     pub g: f64,
 }
 
-/// The `model` object of the JSON outputs.
-#[derive(Serialize, Debug, Clone, Copy)]
-pub struct ModelJson {
-    kind: &'static str,
-    m1: f64,
-    m2: f64,
-    l1: f64,
-    l2: f64,
-    g: f64,
+/// The robot a command works on.
+pub struct Robot {
+    /// The model (plant and, unless told otherwise, controller).
+    pub system: DoublePendulum,
+    /// The parameter file it came from, if any.
+    pub file: Option<RobotFile>,
 }
 
 impl ModelArgs {
-    /// Builds the pendulum, refusing non-physical parameters.
-    pub fn pendulum(&self) -> anyhow::Result<DoublePendulum> {
-        Ok(DoublePendulum::new(PlanarChainParams::point_masses(
-            [self.m1, self.m2],
-            [self.l1, self.l2],
-            self.g,
-        ))?)
+    /// Builds the robot, refusing non-physical parameters and bad files.
+    pub fn robot(&self) -> anyhow::Result<Robot> {
+        Ok(match &self.model {
+            Some(path) => {
+                let file = RobotFile::load(path)?;
+                Robot {
+                    system: file.chain::<2>()?,
+                    file: Some(file),
+                }
+            }
+            None => Robot {
+                system: DoublePendulum::new(PlanarChainParams::point_masses(
+                    [self.m1, self.m2],
+                    [self.l1, self.l2],
+                    self.g,
+                ))?,
+                file: None,
+            },
+        })
+    }
+}
+
+impl Robot {
+    /// The `model` object of the JSON outputs: the paper's keys for the
+    /// point-mass pendulum, the file and its entries for a parameter file.
+    pub fn json(&self) -> serde_json::Value {
+        match &self.file {
+            None => {
+                let p = self.system.params();
+                serde_json::json!({
+                    "kind": "double-pendulum",
+                    "m1": p.links[0].mass, "m2": p.links[1].mass,
+                    "l1": p.links[0].length, "l2": p.links[1].length,
+                    "g": p.gravity,
+                })
+            }
+            Some(f) => {
+                let mut map = serde_json::Map::new();
+                map.insert("kind".into(), "planar-chain".into());
+                map.insert("file".into(), f.path().display().to_string().into());
+                if let Some(name) = f.name() {
+                    map.insert("name".into(), name.into());
+                }
+                for (k, v) in f.entries() {
+                    map.insert(k.clone(), (*v).into());
+                }
+                serde_json::Value::Object(map)
+            }
+        }
     }
 
-    /// The JSON description of the model.
-    pub fn json(&self) -> ModelJson {
-        ModelJson {
-            kind: "double-pendulum",
-            m1: self.m1,
-            m2: self.m2,
-            l1: self.l1,
-            l2: self.l2,
-            g: self.g,
+    /// The controller FMU's model parameters for this robot (`m[j]`, `l[j]`,
+    /// `g`, and for a rigid-link robot `r[j]`, `I[j]` about the joint,
+    /// `Ir[j]`, `gr[j]`, `b[j]`, `cf[j]`, `k[j]`, `q_rest[j]`, `coulomb_sharpness`).
+    pub fn fmu_model_values(&self) -> Vec<(String, f64)> {
+        let p = self.system.params();
+        let mut out = vec![];
+        for (j, link) in p.links.iter().enumerate() {
+            out.push((format!("m[{}]", j + 1), link.mass));
+            out.push((format!("l[{}]", j + 1), link.length));
         }
+        out.push(("g".into(), p.gravity));
+        let point_masses = PlanarChainParams::point_masses(
+            p.links.map(|l| l.mass),
+            p.links.map(|l| l.length),
+            p.gravity,
+        );
+        if *p != point_masses {
+            for (j, (link, joint)) in p.links.iter().zip(&p.joints).enumerate() {
+                let n = j + 1;
+                out.push((format!("r[{n}]"), link.com));
+                out.push((format!("I[{n}]"), link.inertia_about_joint()));
+                out.push((format!("Ir[{n}]"), joint.rotor_inertia));
+                out.push((format!("gr[{n}]"), joint.gear_ratio));
+                out.push((format!("b[{n}]"), joint.viscous));
+                out.push((format!("cf[{n}]"), joint.coulomb));
+                out.push((format!("k[{n}]"), joint.stiffness));
+                out.push((format!("q_rest[{n}]"), joint.rest_angle));
+            }
+            out.push(("coulomb_sharpness".into(), p.coulomb_sharpness));
+        }
+        out
     }
 }
 

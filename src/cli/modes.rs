@@ -1,9 +1,9 @@
 //! `eigenmpc modes`: eigenmode family at given energies, with charts, as JSON.
 
-use super::{ModelArgs, ModelJson, parse_list};
+use super::{ModelArgs, Robot, parse_list};
 use anyhow::Context;
 use clap::Args;
-use eigenmpc::mechanics::Vector;
+use eigenmpc::mechanics::{MechanicalSystem, Vector};
 use eigenmpc::modes::{
     Chart, ContinuationOptions, FMU_CHART_DEGREE, Family, eigenmode_family_with_progress,
     fmu_chart_coef_name, linear_modes,
@@ -39,7 +39,7 @@ pub struct ModesArgs {
 
 /// Start values of the controller FMU for one eigenmode and its chart.
 fn fmu_start_values(
-    model: &ModelArgs,
+    robot: &Robot,
     eigenvector: &Vector<2>,
     energy: f64,
     chart: &Chart<2>,
@@ -54,14 +54,8 @@ fn fmu_start_values(
         values.insert(name, serde_json::Value::from(v));
     };
     put("E_ref".into(), energy);
-    for (name, v) in [
-        ("m[1]", model.m1),
-        ("m[2]", model.m2),
-        ("l[1]", model.l1),
-        ("l[2]", model.l2),
-        ("g", model.g),
-    ] {
-        put(name.into(), v);
+    for (name, v) in robot.fmu_model_values() {
+        put(name, v);
     }
     for j in 0..2 {
         put(format!("c[{}]", j + 1), eigenvector[j]);
@@ -105,7 +99,7 @@ struct ModeJson {
 /// The whole JSON document printed by `eigenmpc modes`.
 #[derive(Serialize)]
 struct ModesJson {
-    model: ModelJson,
+    model: serde_json::Value,
     family: String,
     linear: LinearJson,
     modes: Vec<ModeJson>,
@@ -130,7 +124,8 @@ pub fn run(args: &ModesArgs) -> anyhow::Result<()> {
             2 * (args.degree + 1)
         );
     }
-    let system = args.model.pendulum()?;
+    let robot = args.model.robot()?;
+    let system = robot.system;
     let linear = linear_modes(&system)?[family.index()];
     let opts = ContinuationOptions {
         samples: args.samples,
@@ -152,14 +147,14 @@ pub fn run(args: &ModesArgs) -> anyhow::Result<()> {
     );
     bar.finish_and_clear();
     let orbits = orbits.with_context(|| format!("{family} eigenmodes"))?;
-    let q_eq = Vector::<2>::zeros();
+    let q_eq = system.equilibrium();
     let modes = orbits
         .iter()
         .map(|m| {
             let chart = Chart::fit(&m.path, &linear.eigenvector, &q_eq, args.degree)
                 .with_context(|| format!("chart of the {} J mode", m.energy))?;
             if let Some(path) = &args.fmu_start_values {
-                let values = fmu_start_values(&args.model, &linear.eigenvector, m.energy, &chart)?;
+                let values = fmu_start_values(&robot, &linear.eigenvector, m.energy, &chart)?;
                 let text = serde_json::to_string_pretty(&values)?;
                 std::fs::write(path, text + "\n")
                     .with_context(|| format!("writing {}", path.display()))?;
@@ -185,7 +180,7 @@ pub fn run(args: &ModesArgs) -> anyhow::Result<()> {
         })
         .collect::<anyhow::Result<Vec<_>>>()?;
     let doc = ModesJson {
-        model: args.model.json(),
+        model: robot.json(),
         family: family.to_string(),
         linear: LinearJson {
             omega: linear.omega,

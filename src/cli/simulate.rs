@@ -4,10 +4,15 @@
 use super::ModelArgs;
 use anyhow::{Context, bail};
 use clap::Args;
-use eigenmpc::mechanics::Vector;
-use eigenmpc::modes::{Chart, Family, linear_modes};
-use eigenmpc::mpc::closed_loop::{Summary, mode_and_chart, run, summarise};
-use eigenmpc::mpc::{Controller, MpcConfig, QpBackend, Reference, Variant};
+use eigenmpc::mechanics::{DoublePendulum, MechanicalSystem, Vector};
+use eigenmpc::modes::{Chart, ChartFamily, Family, FamilyOptions, linear_modes};
+use eigenmpc::mpc::closed_loop::{
+    Summary, energy_tail, mode_and_chart, rms_friction_torque, run_tuned, summarise,
+};
+use eigenmpc::mpc::{
+    Controller, MpcConfig, QpBackend, Reference, Variant, prediction_coulomb_sharpness,
+    prediction_substeps,
+};
 use eigenmpc::report::{plot_run, summary_text, write_csv};
 use nalgebra::SVector;
 use std::path::{Path, PathBuf};
@@ -45,9 +50,9 @@ pub struct SimulateArgs {
     /// Shooting interval and sample period (s).
     #[arg(long, default_value_t = 0.025, allow_negative_numbers = true)]
     dt: f64,
-    /// RK4 substeps per interval.
-    #[arg(long, default_value_t = 1)]
-    substeps: usize,
+    /// RK4 substeps per interval (default: 1, or as many as the model's Coulomb friction needs).
+    #[arg(long)]
+    substeps: Option<usize>,
     /// Torque bound (N m).
     #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     tau_max: f64,
@@ -75,6 +80,27 @@ pub struct SimulateArgs {
     /// QP solver: `riccati` (structure-exploiting, default) or `clarabel` (reference).
     #[arg(long, default_value_t = QpBackend::default().to_string())]
     qp: String,
+    /// Curved: degree of the computed chart(s) (the paper: 9).
+    #[arg(long, default_value_t = 9)]
+    chart_degree: usize,
+    /// Curved: compute the mode family over energy at start-up and follow
+    /// E_ref along it (implied by --e-ref-at); default: the chart at E_ref.
+    #[arg(long)]
+    chart_family: bool,
+    /// Top of the family's energy range (J; default max(0.5 V_up, 1.25 E_ref, tuned E_ref),
+    /// V_up the potential with every link upright).
+    #[arg(long, allow_negative_numbers = true)]
+    family_energy_max: Option<f64>,
+    /// Tuned E_ref during the run: `T:E[,T:E...]` (s:J), as an FMU master sets the tunable.
+    #[arg(long, value_name = "T:E,...")]
+    e_ref_at: Option<String>,
+    /// Coulomb slope k of the controller's prediction model (s/rad; default: the plant's,
+    /// lowered so that an RK4 step resolves the friction, see README).
+    #[arg(long, allow_negative_numbers = true)]
+    model_coulomb_sharpness: Option<f64>,
+    /// Penalise the whole torque tau instead of tau - tau_f(qd) (friction fought, not compensated).
+    #[arg(long)]
+    no_friction_compensation: bool,
     #[command(flatten)]
     model: ModelArgs,
 }
@@ -121,6 +147,30 @@ fn chart_from_json(path: &Path, energy: f64) -> anyhow::Result<Chart<2>> {
     )?)
 }
 
+/// Parses `T:E,T:E,...` into (time, energy) pairs in time order.
+fn parse_schedule(text: &str) -> anyhow::Result<Vec<(f64, f64)>> {
+    let mut out = vec![];
+    for item in text.split(',') {
+        let (t, e) = item
+            .split_once(':')
+            .with_context(|| format!("--e-ref-at: '{item}' is not T:E"))?;
+        let t: f64 = t
+            .trim()
+            .parse()
+            .with_context(|| format!("--e-ref-at: time '{t}'"))?;
+        let e: f64 = e
+            .trim()
+            .parse()
+            .with_context(|| format!("--e-ref-at: energy '{e}'"))?;
+        if !(t.is_finite() && t >= 0.0 && e.is_finite() && e > 0.0) {
+            bail!("--e-ref-at: {t}:{e} needs a time >= 0 and an energy > 0");
+        }
+        out.push((t, e));
+    }
+    out.sort_by(|a, b| a.0.total_cmp(&b.0));
+    Ok(out)
+}
+
 /// Runs the subcommand.
 pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
     let variant: Variant = args.variant.parse().map_err(anyhow::Error::msg)?;
@@ -136,47 +186,138 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
     if !(args.energy.is_finite() && args.energy > 0.0) {
         bail!("--energy must be finite and > 0");
     }
-    let system = args.model.pendulum()?;
-    let (mode, chart) = mode_and_chart::<_, 2, 4>(&system, family.index(), args.energy, 9)
-        .with_context(|| format!("{family} eigenmode at {} J", args.energy))?;
-    let reference = match variant {
-        Variant::Straight => Reference::Straight {
-            eigenvector: linear_modes(&system)?[family.index()].eigenvector,
-        },
-        Variant::Curved => Reference::Curved(match &args.chart {
-            Some(path) => chart_from_json(path, args.energy)?,
-            None => chart,
-        }),
+    let schedule = match &args.e_ref_at {
+        Some(text) => parse_schedule(text)?,
+        None => vec![],
     };
+    let robot = args.model.robot()?;
+    let plant = robot.system;
+    let limits = robot.file.as_ref().and_then(|f| f.torque_limits());
+    if let Some(tl) = limits.iter().flatten().find(|&&tl| args.tau_max > tl) {
+        bail!(
+            "--tau-max {} exceeds the robot's motor torque limit {tl} N m",
+            args.tau_max
+        );
+    }
     let mut config = MpcConfig::paper(variant);
     config.horizon = args.horizon;
     config.dt = args.dt;
-    config.substeps = args.substeps;
+    config.substeps = args
+        .substeps
+        .unwrap_or_else(|| prediction_substeps(&plant, args.dt));
     config.tau_max = args.tau_max;
     config.iterations_per_sample = args.iterations;
     config.qp = backend;
     config.cost.e_ref = args.energy;
     config.cost.alpha = args.alpha;
     config.cost.beta = args.beta;
+    config.cost.compensate_friction = !args.no_friction_compensation;
     if let Some(w) = args.w_e {
         config.cost.weights.energy = w;
     }
     config.cost.weights.position = args.w_x;
     config.cost.weights.velocity = args.w_xd;
     config.cost.weights.torque = args.w_f;
-    let mut controller = Controller::<_, 2, 4>::new(system, config, reference)?;
+    config.validate()?;
+    let sharpness = match args.model_coulomb_sharpness {
+        Some(k) => k,
+        None => prediction_coulomb_sharpness(&plant, config.dt / config.substeps as f64),
+    };
+    let model = plant.with_coulomb_sharpness(sharpness)?;
+    let e_final = schedule.last().map_or(args.energy, |s| s.1);
+    let use_family = variant == Variant::Curved && (args.chart_family || !schedule.is_empty());
+    let mut controller = if use_family {
+        if args.chart.is_some() {
+            bail!("--chart and a chart family (--chart-family, --e-ref-at) exclude each other");
+        }
+        let e_max = match args.family_energy_max {
+            Some(e) => e,
+            None => default_family_energy_max(&plant, &schedule, args.energy),
+        };
+        let opts = FamilyOptions {
+            degree: args.chart_degree,
+            ..FamilyOptions::up_to(e_max)
+        };
+        let chart_family = ChartFamily::compute::<_, 4>(&model, family.index(), &opts)
+            .with_context(|| format!("{family} mode family up to {e_max} J"))?;
+        let (lo, hi) = chart_family.energy_range();
+        eprintln!("{family} mode family: charts for {lo:.4} .. {hi:.4} J");
+        if let Some(why) = chart_family.ended_early() {
+            eprintln!("  (ends below {e_max} J: {why})");
+        }
+        Controller::<_, 2, 4>::with_family(model, config, chart_family)?
+    } else {
+        let reference = match variant {
+            Variant::Straight => Reference::Straight {
+                eigenvector: linear_modes(&model)?[family.index()].eigenvector,
+            },
+            Variant::Curved => Reference::Curved(match &args.chart {
+                Some(path) => chart_from_json(path, args.energy)?,
+                None => {
+                    mode_and_chart::<_, 2, 4>(
+                        &model,
+                        family.index(),
+                        args.energy,
+                        args.chart_degree,
+                    )
+                    .with_context(|| format!("{family} eigenmode at {} J", args.energy))?
+                    .1
+                }
+            }),
+        };
+        Controller::<_, 2, 4>::new(model, config, reference)?
+    };
+    let (mode, _) = mode_and_chart::<_, 2, 4>(&plant, family.index(), e_final, 9)
+        .with_context(|| format!("{family} eigenmode of the plant at {e_final} J"))?;
     let z0 = SVector::<f64, 4>::from_column_slice(&x0);
-    let trace = run(&mut controller, &system, &z0, args.duration)?;
-    let summary = summarise(&trace, args.energy, Some(&mode.path), 5.0);
+    let mut next = 0;
+    let trace = run_tuned(&mut controller, &plant, &z0, args.duration, |t, c| {
+        while next < schedule.len() && schedule[next].0 <= t + 1e-9 {
+            // Validated above: finite and > 0.
+            let _ = c.set_e_ref(schedule[next].1);
+            next += 1;
+        }
+    })?;
+    let summary = summarise(&trace, e_final, Some(&mode.path), 5.0);
     print_summary(args, variant, family, &summary);
+    let (mean, rms) = energy_tail(&trace, e_final, 5.0);
+    println!(
+        "energy, last 5 s:               mean {mean:.4} J ({:+.2} %), RMS error {rms:.4} J",
+        100.0 * (mean - e_final) / e_final
+    );
+    if plant.params().has_friction() {
+        let f = rms_friction_torque(&trace, &plant, 5.0);
+        let t = summary.rms_torque;
+        println!(
+            "RMS friction torque along the final orbit, last 5 s: {:.4} / {:.4} N m (torque / friction: {:.2} / {:.2}, combined {:.2})",
+            f[0],
+            f[1],
+            t[0] / f[0],
+            t[1] / f[1],
+            t.norm() / f.norm()
+        );
+        println!(
+            "prediction model:               Coulomb slope k = {sharpness:.4} s/rad (plant {}), {} RK4 substeps",
+            plant.params().coulomb_sharpness,
+            config.substeps
+        );
+    }
     if let Some(path) = &args.csv {
         write_csv(path, &trace).with_context(|| format!("writing {}", path.display()))?;
     }
     if let Some(path) = &args.plot {
-        plot_run(path, &trace, &mode.path, args.energy)
+        plot_run(path, &trace, &mode.path, e_final)
             .with_context(|| format!("plotting {}", path.display()))?;
     }
     Ok(())
+}
+
+/// Default top of the family's range: half the upright potential, and at
+/// least 1.25 times every energy the run asks for.
+fn default_family_energy_max(plant: &DoublePendulum, schedule: &[(f64, f64)], e_ref: f64) -> f64 {
+    let upright = plant.potential(&Vector::<2>::new(std::f64::consts::PI, 0.0));
+    let asked = schedule.iter().map(|s| s.1).fold(e_ref, f64::max);
+    (0.5 * upright).max(1.25 * asked)
 }
 
 fn print_summary(args: &SimulateArgs, variant: Variant, family: Family, s: &Summary<2>) {

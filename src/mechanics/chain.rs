@@ -226,20 +226,15 @@ impl<const N: usize> PlanarChain<N> {
                     reason: "must be finite",
                 });
             }
-            if !(link.inertia.is_finite()
-                && link.inertia >= -1e-12 * link.inertia_about_joint().abs())
-            {
+            // Identified robots give base parameters: the inertia about the
+            // joint and the first moment m r independently, so I < m r^2
+            // (a negative inertia about the COM) occurs (robots/...-B0.yml)
+            // and is accepted while M(q) stays positive definite (below).
+            if !(link.inertia.is_finite() && link.inertia_about_joint() > 0.0) {
                 return Err(ParamsError::Invalid {
                     name: format!("I{n}"),
                     value: link.inertia_about_joint(),
-                    reason: "the inertia about the joint must be finite and >= m r^2 (inertia about the centre of mass >= 0)",
-                });
-            }
-            if link.inertia_about_joint() <= 0.0 {
-                return Err(ParamsError::Invalid {
-                    name: format!("I{n}"),
-                    value: link.inertia_about_joint(),
-                    reason: "the link has no inertia about its joint (a point mass on the axis)",
+                    reason: "the inertia about the joint must be finite and > 0",
                 });
             }
         }
@@ -306,6 +301,7 @@ impl<const N: usize> PlanarChain<N> {
             equilibrium: Vector::<N>::zeros(),
             potential_offset: 0.0,
         };
+        chain.check_inertia()?;
         chain.equilibrium = chain.find_equilibrium()?;
         chain.potential_offset = chain.raw_potential(&chain.equilibrium);
         if chain
@@ -334,6 +330,41 @@ impl<const N: usize> PlanarChain<N> {
             coulomb_sharpness: k,
             ..self.params
         })
+    }
+
+    /// `M(q)` must be positive definite everywhere. It depends on the
+    /// relative angles through `cos(phi_j - phi_l)` only; for two links its
+    /// determinant is concave in `cos q2`, so `q2 = 0, pi` decide; for more,
+    /// a grid of 12 angles per joint is checked.
+    fn check_inertia(&self) -> Result<(), ParamsError> {
+        let per_joint: usize = if N <= 2 { 2 } else { 12 };
+        let total = per_joint.pow(N.saturating_sub(1) as u32);
+        for index in 0..total {
+            let mut rest = index;
+            let q = Vector::<N>::from_fn(|j, _| {
+                if j == 0 {
+                    return 0.0;
+                }
+                let k = rest % per_joint;
+                rest /= per_joint;
+                std::f64::consts::TAU * k as f64 / per_joint as f64
+            });
+            if self.mass_matrix(&q).cholesky().is_none() {
+                let j = (1..=N)
+                    .min_by(|&a, &b| {
+                        self.params.links[a - 1]
+                            .inertia
+                            .total_cmp(&self.params.links[b - 1].inertia)
+                    })
+                    .unwrap_or(1);
+                return Err(ParamsError::Invalid {
+                    name: format!("I{j}"),
+                    value: self.params.links[j - 1].inertia_about_joint(),
+                    reason: "the inertias about the joints are too small for the masses and COM distances: M(q) is not positive definite",
+                });
+            }
+        }
+        Ok(())
     }
 
     /// Stable equilibrium: `q = 0` unless a spring has a rest angle, then

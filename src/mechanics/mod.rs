@@ -8,7 +8,10 @@
 
 mod chain;
 
-pub use chain::{DoublePendulum, Joint, Link, ParamsError, PlanarChain, PlanarChainParams};
+pub use chain::{
+    DEFAULT_COULOMB_SHARPNESS, DoublePendulum, Joint, Link, ParamsError, PlanarChain,
+    PlanarChainParams,
+};
 
 use nalgebra::{SMatrix, SVector};
 

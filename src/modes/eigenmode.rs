@@ -239,12 +239,49 @@ pub fn eigenmode_family_with_progress<S, const N: usize, const NX: usize>(
 where
     S: MechanicalSystem<N> + ?Sized,
 {
+    let mut order: Vec<usize> = (0..energies.len()).collect();
+    order.sort_by(|&a, &b| energies[a].total_cmp(&energies[b]));
+    let sorted: Vec<f64> = order.iter().map(|&i| energies[i]).collect();
+    let mut results: Vec<Option<Eigenmode<N>>> = vec![None; energies.len()];
+    let mut done = 0;
+    continue_family::<S, N, NX>(system, mode_index, &sorted, opts, |mode| {
+        results[order[done]] = Some(mode);
+        done += 1;
+        progress(done);
+        true
+    })?;
+    Ok(results
+        .into_iter()
+        .map(|m| m.expect("every energy solved"))
+        .collect())
+}
+
+/// Continues the family of linear mode `mode_index` through the energies
+/// `sorted` (ascending), handing each verified orbit to `on_mode`, which
+/// returns `false` to stop early (e.g. when the orbit can no longer be
+/// charted). Friction is ignored: eigenmodes are those of the conservative
+/// part.
+pub fn continue_family<S, const N: usize, const NX: usize>(
+    system: &S,
+    mode_index: usize,
+    sorted: &[f64],
+    opts: &ContinuationOptions,
+    mut on_mode: impl FnMut(Eigenmode<N>) -> bool,
+) -> Result<(), ModeError>
+where
+    S: MechanicalSystem<N> + ?Sized,
+{
     const { assert!(NX == 2 * N, "NX must equal 2 N") };
     // Eigenmodes are those of the conservative part: friction off.
     let conservative = Conservative(system);
     let system = &conservative;
-    if let Some(&bad) = energies.iter().find(|e| !(e.is_finite() && **e > 0.0)) {
+    if let Some(&bad) = sorted.iter().find(|e| !(e.is_finite() && **e > 0.0)) {
         return Err(ModeError::InvalidEnergy(bad));
+    }
+    if sorted.windows(2).any(|w| w[1] < w[0]) {
+        return Err(ModeError::ChartFit(
+            "continue_family needs ascending energies".into(),
+        ));
     }
     let modes = linear_modes(system)?;
     let mode = modes.get(mode_index).ok_or(ModeError::NoSuchMode {
@@ -255,15 +292,12 @@ where
     let q_eq = system.equilibrium();
     let c = mode.eigenvector;
     let stiffness = c.dot(&(system.potential_hessian(&q_eq) * c));
-
-    let mut order: Vec<usize> = (0..energies.len()).collect();
-    order.sort_by(|&a, &b| energies[a].total_cmp(&energies[b]));
-    let mut results: Vec<Option<Eigenmode<N>>> = vec![None; energies.len()];
+    let Some(&lowest) = sorted.first() else {
+        return Ok(());
+    };
 
     // First orbit from the linear mode: V ~ 1/2 a^2 c'Kc along q_eq + a c.
-    let e_start = opts
-        .start_energy
-        .min(energies.iter().copied().fold(f64::INFINITY, f64::min));
+    let e_start = opts.start_energy.min(lowest);
     let guess = Shot {
         q0: q_eq + c * (2.0 * e_start / stiffness).sqrt(),
         half_period: std::f64::consts::PI / mode.omega,
@@ -282,8 +316,7 @@ where
     let mut prev: Option<(f64, Shot<N>)> = None;
     let mut cur = (e_start, first);
     let mut step = opts.initial_energy_step;
-    for (done, &idx) in order.iter().enumerate() {
-        let target = energies[idx];
+    for &target in sorted {
         while cur.0 < target {
             let e_next = (cur.0 + step).min(target);
             let predicted = match prev {
@@ -322,11 +355,9 @@ where
         }
         // The loop ends exactly on target (steps are clipped to it).
         let shot = cur.1;
-        results[idx] = Some(verify::<_, N, NX>(system, target, &shot, opts)?);
-        progress(done + 1);
+        if !on_mode(verify::<_, N, NX>(system, target, &shot, opts)?) {
+            break;
+        }
     }
-    Ok(results
-        .into_iter()
-        .map(|m| m.expect("every energy solved"))
-        .collect())
+    Ok(())
 }

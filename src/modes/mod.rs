@@ -5,12 +5,15 @@
 
 mod chart;
 mod eigenmode;
+mod family;
 mod linear;
 
 pub use chart::{Chart, ChartPoint};
 pub use eigenmode::{
-    ContinuationOptions, Eigenmode, eigenmode_family, eigenmode_family_with_progress,
+    ContinuationOptions, Eigenmode, continue_family, eigenmode_family,
+    eigenmode_family_with_progress,
 };
+pub use family::{ChartFamily, FamilyOptions};
 pub use linear::{Family, LinearMode, linear_modes};
 
 use crate::integrate::IntegrationError;

@@ -50,6 +50,38 @@ pub fn run_with<S, P, const N: usize, const NX: usize>(
     plant: &P,
     z0: &SVector<f64, NX>,
     duration: f64,
+    on_sample: impl FnMut(usize, &Controller<S, N, NX>, &ControlOutput<N>),
+) -> Result<Vec<Sample<N, NX>>, IntegrationError>
+where
+    S: MechanicalSystem<N>,
+    P: MechanicalSystem<N>,
+{
+    run_inner(controller, plant, z0, duration, |_, _| {}, on_sample)
+}
+
+/// [`run`], calling `tune(t, controller)` right before the controller's
+/// step at time `t` (e.g. a tuned `E_ref`, as a master sets a tunable
+/// parameter between communication steps).
+pub fn run_tuned<S, P, const N: usize, const NX: usize>(
+    controller: &mut Controller<S, N, NX>,
+    plant: &P,
+    z0: &SVector<f64, NX>,
+    duration: f64,
+    tune: impl FnMut(f64, &mut Controller<S, N, NX>),
+) -> Result<Vec<Sample<N, NX>>, IntegrationError>
+where
+    S: MechanicalSystem<N>,
+    P: MechanicalSystem<N>,
+{
+    run_inner(controller, plant, z0, duration, tune, |_, _, _| {})
+}
+
+fn run_inner<S, P, const N: usize, const NX: usize>(
+    controller: &mut Controller<S, N, NX>,
+    plant: &P,
+    z0: &SVector<f64, NX>,
+    duration: f64,
+    mut tune: impl FnMut(f64, &mut Controller<S, N, NX>),
     mut on_sample: impl FnMut(usize, &Controller<S, N, NX>, &ControlOutput<N>),
 ) -> Result<Vec<Sample<N, NX>>, IntegrationError>
 where
@@ -67,6 +99,7 @@ where
     for i in 0..=steps {
         let t = i as f64 * dt;
         let z = *ode.state();
+        tune(t, controller);
         let out = controller.step(&z);
         on_sample(i, controller, &out);
         trace.push(Sample {
@@ -162,6 +195,48 @@ pub fn distance_to_path<const N: usize>(q: &Vector<N>, path: &[Vector<N>]) -> f6
         best = (q - path[0]).norm();
     }
     best
+}
+
+/// RMS per joint of the friction torque `tau_f(qd)` of `plant` along the
+/// last `window` seconds of a run: what holding that orbit against friction
+/// takes at least.
+pub fn rms_friction_torque<P, const N: usize, const NX: usize>(
+    trace: &[Sample<N, NX>],
+    plant: &P,
+    window: f64,
+) -> Vector<N>
+where
+    P: MechanicalSystem<N>,
+{
+    let t_end = trace.last().map_or(0.0, |s| s.time);
+    let mut sum = Vector::<N>::zeros();
+    let mut n = 0usize;
+    for s in trace.iter().filter(|s| s.time > t_end - window + 1e-9) {
+        let qd = s.state.fixed_rows::<N>(N).into_owned();
+        let f = plant.friction(&qd);
+        sum += f.component_mul(&f);
+        n += 1;
+    }
+    (sum / n.max(1) as f64).map(f64::sqrt)
+}
+
+/// Mean and RMS deviation of the plant energy from `e_ref` over the last
+/// `window` seconds (J).
+pub fn energy_tail<const N: usize, const NX: usize>(
+    trace: &[Sample<N, NX>],
+    e_ref: f64,
+    window: f64,
+) -> (f64, f64) {
+    let t_end = trace.last().map_or(0.0, |s| s.time);
+    let tail: Vec<f64> = trace
+        .iter()
+        .filter(|s| s.time > t_end - window + 1e-9)
+        .map(|s| s.energy)
+        .collect();
+    let n = tail.len().max(1) as f64;
+    let mean = tail.iter().sum::<f64>() / n;
+    let rms = (tail.iter().map(|e| (e - e_ref).powi(2)).sum::<f64>() / n).sqrt();
+    (mean, rms)
 }
 
 /// Computes the [`Summary`] of a run over its last `window` seconds.

@@ -118,6 +118,9 @@ pub struct CostParams {
     pub beta: f64,
     /// Residual weights.
     pub weights: Weights,
+    /// Penalise the torque beyond the model's friction, `tau - tau_f(qd)`,
+    /// instead of `tau` (no effect on a frictionless model).
+    pub compensate_friction: bool,
 }
 
 /// Residuals of one stage and their Jacobians w.r.t. `z = (q, qd)` and `tau`.
@@ -135,7 +138,7 @@ pub struct Residuals<const N: usize, const NX: usize> {
     pub velocity: Vector<N>,
     /// `d r_xd / dz`.
     pub velocity_z: SMatrix<f64, N, NX>,
-    /// Torque residual `r_F`.
+    /// Torque residual `r_F` (`tau`, or `tau - tau_f(qd)` when compensating friction).
     pub torque: Vector<N>,
     /// `d r_F / dz`.
     pub torque_z: SMatrix<f64, N, NX>,
@@ -161,6 +164,18 @@ where
     grad_e.fixed_rows_mut::<N>(0).copy_from(&de_dq);
     grad_e.fixed_rows_mut::<N>(N).copy_from(&de_dqd);
     let eye = Matrix::<N>::identity();
+    // Torque beyond what friction takes: holding an eigenmode against
+    // friction costs nothing (for a frictionless model this is `tau`).
+    let (torque, torque_z) = if params.compensate_friction {
+        let slope = system.friction_slope(&qd);
+        let mut dz = SMatrix::<f64, N, NX>::zeros();
+        for j in 0..N {
+            dz[(j, N + j)] = -slope[j];
+        }
+        (tau - system.friction(&qd), dz)
+    } else {
+        (*tau, SMatrix::zeros())
+    };
     let mut r = Residuals {
         energy: params.e_ref - energy,
         energy_z: -grad_e,
@@ -168,8 +183,8 @@ where
         position_z: SMatrix::zeros(),
         velocity: Vector::<N>::zeros(),
         velocity_z: SMatrix::zeros(),
-        torque: *tau,
-        torque_z: SMatrix::zeros(),
+        torque,
+        torque_z,
         torque_u: eye,
     };
     match reference {
@@ -192,8 +207,8 @@ where
                 .fixed_view_mut::<N, N>(0, N)
                 .copy_from(&(perp * g));
             r.velocity_z -= pqd * dt_dz.transpose();
-            r.torque = tau * (t + params.beta);
-            r.torque_z = tau * dt_dz.transpose();
+            r.torque = torque * (t + params.beta);
+            r.torque_z = torque * dt_dz.transpose() + torque_z * (t + params.beta);
             r.torque_u = eye * (t + params.beta);
         }
         Reference::Curved(chart) => {

@@ -17,11 +17,14 @@
 
 pub mod closed_loop;
 pub mod cost;
+pub mod prediction;
 
 pub use cost::{CostParams, Reference, Variant, Weights};
+pub use prediction::{prediction_coulomb_sharpness, prediction_substeps};
 
 use crate::integrate::rk4_step_sensitivity;
 use crate::mechanics::{MechanicalSystem, Vector, state_energy};
+use crate::modes::ChartFamily;
 pub use crate::qp::QpBackend;
 use crate::qp::{OcpQp, QpSolution, QpSolver, QpStatus};
 use cost::{stage_cost, stage_model};
@@ -95,6 +98,7 @@ impl MpcConfig {
                 alpha: 0.1,
                 beta: 0.1,
                 weights: Weights::paper(variant),
+                compensate_friction: true,
             },
             terminal_scale: 0.0,
             q_max: f64::INFINITY,
@@ -319,6 +323,8 @@ pub struct Controller<S, const N: usize, const NX: usize> {
     warm_start_usable: bool,
     /// QP failures in a row; the plan is rebuilt after [`MAX_QP_FAILURES`].
     consecutive_qp_failures: usize,
+    /// The eigenmanifold the curved chart follows `E_ref` on (None: fixed chart).
+    family: Option<ChartFamily<N>>,
 }
 
 /// Largest accepted horizon `N` (the FMU's `horizon` parameter and the C
@@ -378,7 +384,40 @@ where
             pending_preparation_time: 0.0,
             warm_start_usable: false,
             consecutive_qp_failures: 0,
+            family: None,
         })
+    }
+
+    /// Builds a curved controller whose chart follows `E_ref` along the
+    /// mode family `family`: the chart at `config.cost.e_ref` now, and at
+    /// every tuned `E_ref` from the next sample on (interpolated, no
+    /// allocation). An `E_ref` outside [`ChartFamily::energy_range`] uses
+    /// the chart at the nearest end of the range (see
+    /// [`Controller::chart_energy`]) while the energy residual keeps the
+    /// true `E_ref`.
+    pub fn with_family(
+        system: S,
+        config: MpcConfig,
+        family: ChartFamily<N>,
+    ) -> Result<Self, MpcError> {
+        config.validate()?;
+        let reference = Reference::Curved(family.chart(config.cost.e_ref));
+        let mut controller = Self::new(system, config, reference)?;
+        controller.family = Some(family);
+        Ok(controller)
+    }
+
+    /// The mode family the chart follows, if any.
+    pub fn family(&self) -> Option<&ChartFamily<N>> {
+        self.family.as_ref()
+    }
+
+    /// Energy of the chart in use: `E_ref` clamped to the family's range
+    /// (None for a fixed chart or the straight variant).
+    pub fn chart_energy(&self) -> Option<f64> {
+        self.family
+            .as_ref()
+            .map(|f| f.clamp(self.config.cost.e_ref))
     }
 
     /// The configuration (cost parameters reflect the latest tuning).
@@ -419,6 +458,11 @@ where
     /// Sets all tunable cost parameters at once (no rebuild, no allocation).
     pub fn set_cost(&mut self, cost: CostParams) -> Result<(), MpcError> {
         validate_cost(&cost)?;
+        if let (Some(family), Reference::Curved(chart)) = (&self.family, &mut self.reference)
+            && cost.e_ref != self.config.cost.e_ref
+        {
+            family.write_chart(cost.e_ref, chart);
+        }
         self.config.cost = cost;
         self.prepared = false;
         Ok(())
