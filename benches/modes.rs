@@ -1,9 +1,14 @@
 //! Eigenmode engine benchmark: the whole in-phase family 0.25..16 J (13
 //! energies) with degree-9 charts, as `eigenmpc modes` computes it.
-//! Run with `cargo bench --bench modes`; prints a table.
+//! Then the controller's creation-time work, a whole mode family with its
+//! interpolation table (`ChartFamily::compute`), for 2 and 3 links.
+//! Run with `cargo bench --bench modes`; prints tables.
 
-use eigenmpc::mechanics::{DoublePendulum, Vector};
-use eigenmpc::modes::{Chart, ContinuationOptions, Family, eigenmode_family, linear_modes};
+use eigenmpc::mechanics::{DoublePendulum, MechanicalSystem, PlanarChain, Vector};
+use eigenmpc::model_file::RobotFile;
+use eigenmpc::modes::{
+    Chart, ChartFamily, ContinuationOptions, Family, FamilyOptions, eigenmode_family, linear_modes,
+};
 use std::hint::black_box;
 use std::time::Instant;
 
@@ -31,6 +36,39 @@ fn family_with_charts(family: Family) -> usize {
         .sum()
 }
 
+fn median_ms(mut f: impl FnMut()) -> (f64, f64, f64) {
+    let mut times: Vec<f64> = (0..15)
+        .map(|_| {
+            let t = Instant::now();
+            f();
+            t.elapsed().as_secs_f64() * 1e3
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    (times[times.len() / 2], times[0], times[times.len() - 1])
+}
+
+/// Half the potential with every link upright: the default top of a family.
+fn half_upright<const N: usize, S: MechanicalSystem<N>>(sys: &S) -> f64 {
+    let mut q = Vector::<N>::zeros();
+    q[0] = std::f64::consts::PI;
+    0.5 * sys.potential(&q)
+}
+
+fn family_row<const N: usize, const NX: usize, S: MechanicalSystem<N>>(name: &str, sys: &S) {
+    let opts = FamilyOptions::up_to(half_upright(sys));
+    let family = ChartFamily::<N>::compute::<S, NX>(sys, 0, &opts).expect("family");
+    let (lo, hi) = family.energy_range();
+    let worst = family.residuals().iter().copied().fold(0.0, f64::max);
+    let (med, min, max) = median_ms(|| {
+        black_box(ChartFamily::<N>::compute::<S, NX>(sys, 0, &opts).expect("family"));
+    });
+    println!(
+        "| {name} | {N} | {lo:.3} .. {hi:.2} J | {} | {worst:.1e} | {med:.1} | {min:.1} | {max:.1} |",
+        family.energies().len()
+    );
+}
+
 fn main() {
     println!(
         "| family (13 energies 0.25..16 J, charts deg 9) | runs | median ms | min ms | max ms |"
@@ -53,4 +91,21 @@ fn main() {
             times[times.len() - 1]
         );
     }
+    println!();
+    println!(
+        "| mode family (in-phase, degree-9 charts) | links | energy range | grid energies | worst chart residual (rad) | median ms | min ms | max ms |"
+    );
+    println!("|---|---|---|---|---|---|---|---|");
+    family_row::<2, 4, _>("paper double pendulum", &DoublePendulum::default());
+    let robot = RobotFile::load(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/robots/lab-double-pendulum-A0.yml"
+    ))
+    .and_then(|f| f.chain::<2>())
+    .expect("robot file");
+    family_row::<2, 4, _>("lab pendulum A0 (rigid links, motors)", &robot);
+    family_row::<3, 6, _>(
+        "3-link point-mass chain (1 kg, 1 m)",
+        &PlanarChain::<3>::default(),
+    );
 }

@@ -198,3 +198,31 @@ fn friction_is_compensated_on_the_identified_robot() {
     );
     assert!(s.rms_distance.unwrap() < 0.02);
 }
+
+/// A 3-link point-mass chain: started at a turning point of its 20 J
+/// in-phase eigenmode, the curved controller keeps it there torque-free
+/// (from rest it gets there in 37 s: `examples/three_link.rs`).
+#[test]
+fn three_link_chain_stays_on_its_eigenmode_torque_free() {
+    use eigenmpc::mechanics::PlanarChain;
+    let sys = PlanarChain::<3>::default();
+    let family = ChartFamily::compute::<_, 6>(&sys, 0, &FamilyOptions::up_to(25.0)).unwrap();
+    let mut config = MpcConfig::paper(Variant::Curved);
+    config.cost.e_ref = 20.0;
+    config.horizon = 60;
+    let mut ctrl = Controller::<_, 3, 6>::with_family(sys, config, family).unwrap();
+    let (mode, _) = mode_and_chart::<_, 3, 6>(&sys, 0, 20.0, 9).unwrap();
+    let q = mode.turning_point;
+    let z0 = SVector::<f64, 6>::new(q[0], q[1], q[2], 0.0, 0.0, 0.0);
+    let trace = run_tuned(&mut ctrl, &sys, &z0, 8.0, |_, _| {}).unwrap();
+    let s = summarise(&trace, 20.0, Some(&mode.path), 5.0);
+    let (mean, _) = energy_tail(&trace, 20.0, 5.0);
+    eprintln!(
+        "3 links on the 20 J mode: mean {mean}, RMS tau {}, distance {:?}",
+        s.rms_torque, s.rms_distance
+    );
+    assert!((mean - 20.0).abs() < 0.01 * 20.0, "energy {mean}");
+    assert!(s.rms_torque.amax() < 0.05, "RMS torque {}", s.rms_torque);
+    assert!(s.rms_distance.unwrap() < 0.01);
+    assert_eq!(s.failures, 0);
+}

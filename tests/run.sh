@@ -5,23 +5,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-apt_install() {
-    if [ "$(id -u)" != 0 ]; then
-        echo "missing Debian packages: $*; install them as root (apt-get install $*)" >&2
-        exit 1
-    fi
-    if [ -z "${APT_UPDATED:-}" ]; then
-        apt-get update -qq
-        APT_UPDATED=1
-    fi
-    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "$@"
-}
-
-# fmi-sys runs bindgen on the FMI headers at build time: it needs libclang.
-dpkg -s libclang-dev >/dev/null 2>&1 || apt_install libclang-dev
-# The symbol test lists the FMU's exports with nm.
-command -v nm >/dev/null 2>&1 || apt_install binutils
-command -v gcc >/dev/null 2>&1 || apt_install gcc
+# apt_install and the build's Debian packages (libclang-dev, binutils, gcc).
+source scripts/ensure-build-deps.sh
 
 echo "== cargo fmt --check"
 cargo fmt --all -- --check
@@ -33,7 +18,7 @@ echo "== fmu-build (release cdylibs, target/fmu/*.fmu, include/eigenmpc.h)"
 cargo run -p fmu-build
 
 echo "== demo (the main job, on the FMUs just built): controller FMU drives plant FMU"
-cargo run --release -q -p eigenmpc-demo -- --no-build --out-dir target/demo-ci
+bash demo/run.sh --no-build --out-dir target/demo-ci
 for f in demo.csv demo.png demo.svg; do
     test -s "target/demo-ci/$f" || { echo "demo did not write target/demo-ci/$f" >&2; exit 1; }
 done

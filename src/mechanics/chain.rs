@@ -183,6 +183,8 @@ pub struct PlanarChain<const N: usize> {
     equilibrium: Vector<N>,
     /// Gravity and spring energy at `q_eq`, subtracted so that `V(q_eq) = 0`.
     potential_offset: f64,
+    /// No viscous or Coulomb friction at any joint.
+    frictionless: bool,
 }
 
 /// The paper's double pendulum: `theta_1` absolute, `theta_2` relative.
@@ -300,6 +302,7 @@ impl<const N: usize> PlanarChain<N> {
             gravity_amplitude,
             equilibrium: Vector::<N>::zeros(),
             potential_offset: 0.0,
+            frictionless: !params.has_friction(),
         };
         chain.check_inertia()?;
         chain.equilibrium = chain.find_equilibrium()?;
@@ -514,6 +517,10 @@ impl<const N: usize> MechanicalSystem<N> for PlanarChain<N> {
     }
 
     fn friction(&self, qd: &Vector<N>) -> Vector<N> {
+        if self.frictionless {
+            // The per-sample path of a frictionless model skips the atan.
+            return Vector::<N>::zeros();
+        }
         let k = self.params.coulomb_sharpness;
         Vector::<N>::from_fn(|j, _| {
             let joint = &self.params.joints[j];
@@ -522,6 +529,9 @@ impl<const N: usize> MechanicalSystem<N> for PlanarChain<N> {
     }
 
     fn friction_slope(&self, qd: &Vector<N>) -> Vector<N> {
+        if self.frictionless {
+            return Vector::<N>::zeros();
+        }
         let k = self.params.coulomb_sharpness;
         Vector::<N>::from_fn(|j, _| {
             let joint = &self.params.joints[j];
