@@ -20,4 +20,3 @@ pub mod model_file;
 pub mod modes;
 pub mod mpc;
 pub mod qp;
-pub mod report;

@@ -14,7 +14,7 @@ use eigenmpc::mechanics::{DoublePendulum, PlanarChainParams};
 use eigenmpc::modes::Family;
 use eigenmpc::mpc::ControlStatus;
 use eigenmpc::mpc::closed_loop::{Sample, mode_and_chart, summarise};
-use eigenmpc::report::{plot_run, summary_text, write_csv};
+use eigenmpc_cli::report::{plot_run, summary_text, write_csv};
 use fmi::fmi2::Fmi2Res;
 use fmi::fmi2::import::Fmi2Import;
 use fmi::fmi2::instance::{CoSimulation, Common, InstanceCS};

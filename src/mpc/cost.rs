@@ -2,6 +2,7 @@
 //! `l = w_E r_E^2 + w_x |r_x|^2 + w_xd |r_xd|^2 + w_F |r_F|^2`, their exact
 //! residual Jacobians and the Gauss-Newton Hessian blocks they give.
 
+use super::Variant;
 use crate::mechanics::{Matrix, MechanicalSystem, Vector, unpack_state};
 use crate::modes::Chart;
 use nalgebra::{SMatrix, SVector};
@@ -24,45 +25,11 @@ impl Weights {
     /// `w_F = 225`, `w_E = 25` (curved) or `5` (straight).
     pub fn paper(variant: Variant) -> Self {
         Self {
-            energy: match variant {
-                Variant::Curved => 25.0,
-                Variant::Straight => 5.0,
-            },
+            energy: variant.info().paper_energy_weight,
             position: 50.0,
             velocity: 2500.0,
             torque: 225.0,
         }
-    }
-}
-
-/// Which EigenMPC cost.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Variant {
-    /// Distance to the linear eigenvector line, blended by `tanh(alpha E)`.
-    Straight,
-    /// Distance to a precomputed eigenmode chart `X(s)`.
-    Curved,
-}
-
-impl std::str::FromStr for Variant {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "straight" => Ok(Variant::Straight),
-            "curved" => Ok(Variant::Curved),
-            other => Err(format!(
-                "unknown variant '{other}' (expected straight or curved)"
-            )),
-        }
-    }
-}
-
-impl std::fmt::Display for Variant {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            Variant::Straight => "straight",
-            Variant::Curved => "curved",
-        })
     }
 }
 

@@ -13,7 +13,7 @@ use eigenmpc::mpc::{
     Controller, MpcConfig, QpBackend, Reference, Variant, prediction_coulomb_sharpness,
     prediction_substeps,
 };
-use eigenmpc::report::{plot_run, summary_text, write_csv};
+use eigenmpc_cli::report::{plot_run, summary_text, write_csv};
 use nalgebra::SVector;
 use std::path::{Path, PathBuf};
 

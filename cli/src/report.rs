@@ -1,8 +1,8 @@
 //! Output of closed-loop runs for people: the summary text, CSV and the
 //! paper-style plots (shared by `eigenmpc simulate` and the FMU demo).
 
-use crate::mechanics::Vector;
-use crate::mpc::closed_loop::{Sample, Summary};
+use eigenmpc::mechanics::Vector;
+use eigenmpc::mpc::closed_loop::{Sample, Summary};
 use plotters::prelude::*;
 use std::fmt::Write as _;
 use std::io::Write;
@@ -76,7 +76,7 @@ pub fn write_csv(path: &Path, trace: &[Sample<2, 4>]) -> std::io::Result<()> {
 /// One plotted quantity of a sample.
 type SampleValue = fn(&Sample<2, 4>) -> f64;
 
-const FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
+const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
 /// Draws the paper-style panels of a run (joint-space path with the true
 /// eigenmode, energy, theta1, theta2, tau1, tau2): PNG, or SVG when the file

@@ -179,7 +179,7 @@ fn fmu_start_values_carry_the_chart_of_the_requested_mode() {
 }
 
 fn robot_file(name: &str) -> String {
-    format!("{}/robots/{name}", env!("CARGO_MANIFEST_DIR"))
+    format!("{}/../robots/{name}", env!("CARGO_MANIFEST_DIR"))
 }
 
 #[test]

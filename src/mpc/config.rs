@@ -1,0 +1,199 @@
+//! Controller configuration (sized at creation, validated as a whole) and
+//! its errors.
+
+use super::Variant;
+use super::cost::{CostParams, Weights};
+use crate::qp::QpBackend;
+use thiserror::Error;
+
+/// Largest accepted horizon `N` (the FMU's `horizon` parameter and the C
+/// API share it; memory and time grow linearly in `N`).
+pub const MAX_HORIZON: usize = 1000;
+
+/// Settings of the converged SQP mode.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SqpOptions {
+    /// Iteration limit.
+    pub max_iterations: usize,
+    /// Stop when the step's infinity norm is below this (after a full step).
+    pub tolerance: f64,
+}
+
+impl Default for SqpOptions {
+    fn default() -> Self {
+        Self {
+            max_iterations: 30,
+            tolerance: 1e-5,
+        }
+    }
+}
+
+/// Controller configuration. [`MpcConfig::paper`] gives the paper's values.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MpcConfig {
+    /// Shooting intervals `N`.
+    pub horizon: usize,
+    /// Shooting interval and sample period `dt` (s).
+    pub dt: f64,
+    /// RK4 substeps per shooting interval.
+    pub substeps: usize,
+    /// Torque bound `|tau_i| <= tau_max` (N m).
+    pub tau_max: f64,
+    /// Cost parameters (tunable between samples).
+    pub cost: CostParams,
+    /// Terminal cost `terminal_scale * l(z_N, 0)` (0: none, as the paper).
+    pub terminal_scale: f64,
+    /// Soft joint-angle bound `|q_i - q_eq,i| <= q_max` (`inf`: none).
+    pub q_max: f64,
+    /// Soft joint-speed bound `|qd_i| <= qd_max` (`inf`: none).
+    pub qd_max: f64,
+    /// Exact (L1) penalty on soft-bound violations.
+    pub soft_l1: f64,
+    /// Quadratic penalty on soft-bound violations.
+    pub soft_l2: f64,
+    /// SQP iterations per sample (1 = plain RTI).
+    pub iterations_per_sample: usize,
+    /// Solve the first sample to convergence (else start from a zero-torque guess).
+    pub converge_first_sample: bool,
+    /// Converged-SQP settings.
+    pub sqp: SqpOptions,
+    /// QP solver built by [`Controller::new`] (default riccati, see docs/results.md).
+    pub qp: QpBackend,
+}
+
+impl MpcConfig {
+    /// The paper's setting (section V-A): N = 80, dt = 25 ms, |tau| <= 1 N m,
+    /// w_x = 50, w_xd = 2500, w_F = 225, w_E = 25 (curved) / 5 (straight),
+    /// alpha = beta = 0.1, E_ref = 14 J.
+    pub fn paper(variant: Variant) -> Self {
+        Self {
+            horizon: 80,
+            dt: 0.025,
+            substeps: 1,
+            tau_max: 1.0,
+            cost: CostParams {
+                e_ref: 14.0,
+                alpha: 0.1,
+                beta: 0.1,
+                weights: Weights::paper(variant),
+                compensate_friction: true,
+            },
+            terminal_scale: 0.0,
+            q_max: f64::INFINITY,
+            qd_max: f64::INFINITY,
+            soft_l1: 1e3,
+            soft_l2: 1e3,
+            iterations_per_sample: 1,
+            converge_first_sample: true,
+            sqp: SqpOptions::default(),
+            qp: QpBackend::default(),
+        }
+    }
+
+    /// Checks every field; the message names the offending one.
+    pub fn validate(&self) -> Result<(), MpcError> {
+        let bad = |name: &'static str, value: f64, reason: &'static str| {
+            Err(MpcError::InvalidParameter {
+                name,
+                value,
+                reason,
+            })
+        };
+        if self.horizon == 0 || self.horizon > MAX_HORIZON {
+            return bad("horizon", self.horizon as f64, "must be in 1..=1000");
+        }
+        if !(self.dt.is_finite() && self.dt > 0.0) {
+            return bad("dt", self.dt, "must be finite and > 0");
+        }
+        if self.substeps == 0 || self.substeps > 1000 {
+            return bad("substeps", self.substeps as f64, "must be in 1..=1000");
+        }
+        if !(self.tau_max.is_finite() && self.tau_max > 0.0) {
+            return bad("tau_max", self.tau_max, "must be finite and > 0");
+        }
+        validate_cost(&self.cost)?;
+        if !(self.terminal_scale.is_finite() && self.terminal_scale >= 0.0) {
+            return bad(
+                "terminal_scale",
+                self.terminal_scale,
+                "must be finite and >= 0",
+            );
+        }
+        for (name, v) in [("q_max", self.q_max), ("qd_max", self.qd_max)] {
+            if v.is_nan() || v <= 0.0 {
+                return bad(name, v, "must be > 0 (inf: no bound)");
+            }
+        }
+        for (name, v) in [("soft_l1", self.soft_l1), ("soft_l2", self.soft_l2)] {
+            if !(v.is_finite() && v >= 0.0) {
+                return bad(name, v, "must be finite and >= 0");
+            }
+        }
+        if self.iterations_per_sample == 0 || self.iterations_per_sample > 100 {
+            return bad(
+                "iterations_per_sample",
+                self.iterations_per_sample as f64,
+                "must be in 1..=100",
+            );
+        }
+        if self.sqp.max_iterations == 0 {
+            return bad("sqp.max_iterations", 0.0, "must be >= 1");
+        }
+        if !(self.sqp.tolerance.is_finite() && self.sqp.tolerance > 0.0) {
+            return bad(
+                "sqp.tolerance",
+                self.sqp.tolerance,
+                "must be finite and > 0",
+            );
+        }
+        Ok(())
+    }
+}
+
+pub(crate) fn validate_cost(c: &CostParams) -> Result<(), MpcError> {
+    let checks = [
+        ("e_ref", c.e_ref),
+        ("alpha", c.alpha),
+        ("beta", c.beta),
+        ("w_E", c.weights.energy),
+        ("w_x", c.weights.position),
+        ("w_xd", c.weights.velocity),
+        ("w_F", c.weights.torque),
+    ];
+    for (name, value) in checks {
+        if !(value.is_finite() && value >= 0.0) {
+            return Err(MpcError::InvalidParameter {
+                name,
+                value,
+                reason: "must be finite and >= 0",
+            });
+        }
+    }
+    if c.weights.torque == 0.0 {
+        // Without a torque weight the QP Hessian is singular in tau.
+        return Err(MpcError::InvalidParameter {
+            name: "w_F",
+            value: 0.0,
+            reason: "must be > 0",
+        });
+    }
+    Ok(())
+}
+
+/// Why a controller could not be built or tuned.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum MpcError {
+    /// A configuration or tuning value is out of range.
+    #[error("parameter {name} = {value} is invalid: {reason}")]
+    InvalidParameter {
+        /// Parameter name (`w_E`, `dt`, ...).
+        name: &'static str,
+        /// The offending value.
+        value: f64,
+        /// The expected range.
+        reason: &'static str,
+    },
+    /// The eigenvector or chart is unusable.
+    #[error("invalid reference: {0}")]
+    InvalidReference(String),
+}
