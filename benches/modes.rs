@@ -48,15 +48,8 @@ fn median_ms(mut f: impl FnMut()) -> (f64, f64, f64) {
     (times[times.len() / 2], times[0], times[times.len() - 1])
 }
 
-/// Half the potential with every link upright: the default top of a family.
-fn half_upright<const N: usize, S: MechanicalSystem<N>>(sys: &S) -> f64 {
-    let mut q = Vector::<N>::zeros();
-    q[0] = std::f64::consts::PI;
-    0.5 * sys.potential(&q)
-}
-
 fn family_row<const N: usize, const NX: usize, S: MechanicalSystem<N>>(name: &str, sys: &S) {
-    let opts = FamilyOptions::up_to(half_upright(sys));
+    let opts = FamilyOptions::for_system(sys, &[]);
     let family = ChartFamily::<N>::compute::<S, NX>(sys, 0, &opts).expect("family");
     let (lo, hi) = family.energy_range();
     let worst = family.residuals().iter().copied().fold(0.0, f64::max);

@@ -57,6 +57,24 @@ impl FamilyOptions {
         }
     }
 
+    /// [`FamilyOptions::up_to`] the default top for `system` and the
+    /// energies a user asks for: half the potential with every link upright
+    /// (above it the in-phase charts stop following the orbits), and at
+    /// least 1.25 times the largest requested energy.
+    pub fn for_system<S, const N: usize>(system: &S, requested: &[f64]) -> Self
+    where
+        S: MechanicalSystem<N> + ?Sized,
+    {
+        let mut upright = system.equilibrium();
+        upright[0] += std::f64::consts::PI;
+        let asked = requested
+            .iter()
+            .copied()
+            .filter(|e| e.is_finite())
+            .fold(0.0, f64::max);
+        Self::up_to((0.5 * system.potential(&upright)).max(1.25 * asked))
+    }
+
     fn validate(&self) -> Result<(), ModeError> {
         if !(self.energy_min.is_finite()
             && self.energy_min > 0.0

@@ -4,7 +4,7 @@
 use super::ModelArgs;
 use anyhow::{Context, bail};
 use clap::Args;
-use eigenmpc::mechanics::{DoublePendulum, MechanicalSystem, Vector};
+use eigenmpc::mechanics::Vector;
 use eigenmpc::modes::{Chart, ChartFamily, Family, FamilyOptions, linear_modes};
 use eigenmpc::mpc::closed_loop::{
     Summary, energy_tail, mode_and_chart, rms_friction_torque, run_tuned, summarise,
@@ -230,13 +230,15 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
         if args.chart.is_some() {
             bail!("--chart and a chart family (--chart-family, --e-ref-at) exclude each other");
         }
-        let e_max = match args.family_energy_max {
-            Some(e) => e,
-            None => default_family_energy_max(&plant, &schedule, args.energy),
+        let asked: Vec<f64> = schedule.iter().map(|s| s.1).chain([args.energy]).collect();
+        let defaults = match args.family_energy_max {
+            Some(e) => FamilyOptions::up_to(e),
+            None => FamilyOptions::for_system(&plant, &asked),
         };
+        let e_max = defaults.energy_max;
         let opts = FamilyOptions {
             degree: args.chart_degree,
-            ..FamilyOptions::up_to(e_max)
+            ..defaults
         };
         let chart_family = ChartFamily::compute::<_, 4>(&model, family.index(), &opts)
             .with_context(|| format!("{family} mode family up to {e_max} J"))?;
@@ -310,14 +312,6 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
             .with_context(|| format!("plotting {}", path.display()))?;
     }
     Ok(())
-}
-
-/// Default top of the family's range: half the upright potential, and at
-/// least 1.25 times every energy the run asks for.
-fn default_family_energy_max(plant: &DoublePendulum, schedule: &[(f64, f64)], e_ref: f64) -> f64 {
-    let upright = plant.potential(&Vector::<2>::new(std::f64::consts::PI, 0.0));
-    let asked = schedule.iter().map(|s| s.1).fold(e_ref, f64::max);
-    (0.5 * upright).max(1.25 * asked)
 }
 
 fn print_summary(args: &SimulateArgs, variant: Variant, family: Family, s: &Summary<2>) {
