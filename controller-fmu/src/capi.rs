@@ -15,13 +15,22 @@
 //! return value (NULL, a negative status) and a message, never an abort.
 //! A handle may be used from any thread, one call at a time.
 
-use crate::STATUS_BAD_ARGUMENT;
-use crate::settings::{CHART_COEFFICIENTS, PendulumController, Settings, Tuning};
-use eigenmpc::mechanics::PlanarChainParams;
+use crate::{PendulumController, STATUS_BAD_ARGUMENT};
 use eigenmpc::mpc::{ControlOutput, ControlStatus, Variant};
+use eigenmpc_fmu_models::chain::ChainParameters;
+use eigenmpc_fmu_models::controller::ControllerProduct;
+use eigenmpc_fmu_models::controller::settings::{Settings, Tuning};
+use eigenmpc_fmu_models::enums::{QP_SOLVER, VARIANT};
+use eigenmpc_fmu_models::products::EigenMpc2;
 use nalgebra::SVector;
 use std::ffi::{CString, c_char};
 use std::panic::{AssertUnwindSafe, catch_unwind};
+
+/// Number of chart coefficients per joint in [`eigenmpc_create`]'s
+/// `chart_coef` (powers 0..9; a literal for the C header).
+pub const CHART_COEFFICIENTS: usize = 10;
+const _: () =
+    assert!(CHART_COEFFICIENTS == eigenmpc_fmu_models::controller::settings::CHART_COEFFICIENTS);
 
 /// Controller configuration for [`eigenmpc_create`]. Get the paper's values
 /// from [`eigenmpc_config_default`] and change what you need.
@@ -93,18 +102,18 @@ impl EigenMpc {
     }
 }
 
-fn settings_from(config: &EigenMpcConfig) -> Result<Settings, String> {
-    let variant = crate::variant_from_item(config.variant)?;
+fn settings_from(config: &EigenMpcConfig) -> Result<Settings<2>, String> {
+    let variant = VARIANT.value(config.variant)?;
     Ok(Settings {
         variant,
-        qp: crate::qp_backend(config.qp_solver)?,
+        qp: QP_SOLVER.value(config.qp_solver)?,
         tuning: tuning_from(config),
         tau_max: config.tau_max,
         horizon: config.horizon as usize,
         sample_period: config.sample_period,
-        model: PlanarChainParams::point_masses(config.masses, config.lengths, config.gravity),
+        model: ChainParameters::point_masses(config.masses, config.lengths, config.gravity),
         eigenvector: config.eigenvector,
-        chart: Settings::paper(variant).chart,
+        chart: EigenMpc2::CHART,
     })
 }
 
@@ -143,7 +152,7 @@ unsafe fn write_error(buffer: *mut c_char, len: usize, message: &str) {
 /// eigenvector. An unknown variant is kept and refused by [`eigenmpc_create`].
 #[unsafe(no_mangle)]
 pub extern "C" fn eigenmpc_config_default(variant: i32) -> EigenMpcConfig {
-    let s = Settings::paper(Variant::Curved);
+    let s = EigenMpc2::settings(Variant::Curved);
     EigenMpcConfig {
         variant,
         e_ref: s.tuning.e_ref,
@@ -156,11 +165,11 @@ pub extern "C" fn eigenmpc_config_default(variant: i32) -> EigenMpcConfig {
         tau_max: s.tau_max,
         horizon: s.horizon as u32,
         sample_period: s.sample_period,
-        masses: s.model.links.map(|l| l.mass),
-        lengths: s.model.links.map(|l| l.length),
+        masses: s.model.mass,
+        lengths: s.model.length,
         gravity: s.model.gravity,
         eigenvector: s.eigenvector,
-        qp_solver: crate::qp_solver_item(s.qp),
+        qp_solver: QP_SOLVER.item(s.qp),
     }
 }
 
@@ -196,7 +205,7 @@ pub unsafe extern "C" fn eigenmpc_create(
                 row.copy_from_slice(&coef[j * CHART_COEFFICIENTS..(j + 1) * CHART_COEFFICIENTS]);
             }
         }
-        let controller = settings.build()?;
+        let controller = settings.build::<4>()?;
         Ok(EigenMpc {
             controller,
             variant: settings.variant,

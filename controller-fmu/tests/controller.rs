@@ -4,12 +4,12 @@
 //! built shared library.
 
 use eigenmpc::mechanics::{DoublePendulum, Vector};
-use eigenmpc::modes::{Chart, FMU_CHART_DEGREE, fmu_chart_coef_name};
+use eigenmpc::modes::Chart;
 use eigenmpc::mpc::closed_loop::{mode_and_chart, run};
 use eigenmpc::mpc::{ControlStatus, Variant};
 use eigenmpc_fmu::capi::*;
 use eigenmpc_fmu::fmi2_exports::*;
-use eigenmpc_fmu::settings::{CHART_COEFFICIENTS, Settings};
+use eigenmpc_fmu::settings::CHART_COEFFICIENTS;
 use eigenmpc_fmu::*;
 use fmi2_slave::testing::TestInstance;
 use fmi2_slave::{Model, Value, ffi, xml};
@@ -21,7 +21,17 @@ use std::ptr;
 const OK: ffi::fmi2Status = ffi::fmi2Status_fmi2OK;
 const WARNING: ffi::fmi2Status = ffi::fmi2Status_fmi2Warning;
 const ERROR: ffi::fmi2Status = ffi::fmi2Status_fmi2Error;
-const STATE: [u32; 4] = [VR_Q1, VR_Q2, VR_QD1, VR_QD2];
+/// Value reference of `name` in the FMU's variable table.
+fn vref(name: &str) -> u32 {
+    EigenMpcFmu::description()
+        .variable(name)
+        .unwrap_or_else(|| panic!("no variable {name}"))
+        .value_reference
+}
+
+fn state() -> [u32; 4] {
+    [vref("q[1]"), vref("q[2]"), vref("qd[1]"), vref("qd[2]")]
+}
 
 struct Fmu {
     c: ffi::fmi2Component,
@@ -56,7 +66,7 @@ impl Fmu {
         unsafe {
             assert_eq!(fmi2SetupExperiment(fmu.c, 0, 0.0, 0.0, 0, 0.0), OK);
             assert_eq!(fmi2EnterInitializationMode(fmu.c), OK);
-            assert_eq!(fmu.set(&STATE, &z0), OK);
+            assert_eq!(fmu.set(&state(), &z0), OK);
             assert_eq!(
                 fmi2ExitInitializationMode(fmu.c),
                 OK,
@@ -77,7 +87,7 @@ impl Fmu {
 
     fn tau(&self) -> [f64; 2] {
         let mut v = [f64::NAN; 2];
-        let vr = [VR_TAU1, VR_TAU2];
+        let vr = [vref("tau[1]"), vref("tau[2]")];
         assert_eq!(
             unsafe { fmi2GetReal(self.c, vr.as_ptr(), 2, v.as_mut_ptr()) },
             OK
@@ -116,7 +126,7 @@ const DT: f64 = 0.025;
 /// States and torques of a native closed loop of `seconds` (controller
 /// built from the same settings as the FMU's defaults).
 fn native_trace(seconds: f64) -> Vec<(SVector<f64, 4>, Vector<2>)> {
-    let mut controller = Settings::paper(Variant::Curved).build().unwrap();
+    let mut controller = EigenMpc2::settings(Variant::Curved).build::<4>().unwrap();
     let trace = run(
         &mut controller,
         &DoublePendulum::default(),
@@ -137,15 +147,15 @@ fn solves_on_the_sample_grid_and_holds_in_between() {
         [native[0].1[0], native[0].1[1]],
         "first solve at init"
     );
-    assert_eq!(fmu.integer(VR_SOLVER_STATUS), 0);
-    assert!(fmu.integer(VR_QP_ITERATIONS) > 0);
+    assert_eq!(fmu.integer(vref("solver_status")), 0);
+    assert!(fmu.integer(vref("qp_iterations")) > 0);
     for (k, (z, tau)) in native.iter().enumerate().take(native.len() - 1) {
-        assert_eq!(fmu.set(&STATE, z.as_slice()), OK);
+        assert_eq!(fmu.set(&state(), z.as_slice()), OK);
         assert_eq!(fmu.step(DT), OK, "{:?}", fmu.instance.log.lines());
         assert_eq!(fmu.tau(), [tau[0], tau[1]], "sample {k}");
         let e = eigenmpc_fmu_energy(z);
-        assert!((fmu.real(VR_ENERGY) - e).abs() < 1e-12);
-        assert!(fmu.real(VR_SOLVE_TIME) > 0.0);
+        assert!((fmu.real(vref("energy")) - e).abs() < 1e-12);
+        assert!(fmu.real(vref("solve_time")) > 0.0);
     }
     // Five communication steps per sample: solves only on the grid; the
     // inputs between grid points do not matter.
@@ -154,7 +164,7 @@ fn solves_on_the_sample_grid_and_holds_in_between() {
         for i in 0..5 {
             let decoy = z.map(|v| v + 0.3 * i as f64);
             let input = if i == 0 { *z } else { decoy };
-            assert_eq!(fmu.set(&STATE, input.as_slice()), OK);
+            assert_eq!(fmu.set(&state(), input.as_slice()), OK);
             assert_eq!(fmu.step(DT / 5.0), OK);
             assert_eq!(fmu.tau(), [tau[0], tau[1]], "sample {k}, substep {i}");
         }
@@ -177,10 +187,10 @@ fn off_grid_and_long_steps_warn_once_and_keep_solving() {
     let mut held = eigenmpc_fmu_energy(&SVector::from(Z0));
     for i in 0..20 {
         let z = SVector::from([Z0[0] + 0.001 * i as f64, Z0[1], Z0[2], Z0[3]]);
-        assert_eq!(fmu.set(&STATE, z.as_slice()), OK);
+        assert_eq!(fmu.set(&state(), z.as_slice()), OK);
         let t = fmu.t;
         statuses.push(fmu.step(0.01));
-        let energy = fmu.real(VR_ENERGY);
+        let energy = fmu.real(vref("energy"));
         if i > 0 && energy == eigenmpc_fmu_energy(&z) {
             solved_at.push(t);
             held = energy;
@@ -225,7 +235,7 @@ fn new_initial_inputs_after_initialization_are_solved_again() {
     let native = native_trace(0.05);
     let mut fmu = Fmu::start(&[], &[], [0.3, -0.2, 0.0, 0.0]);
     let first = fmu.tau();
-    assert_eq!(fmu.set(&STATE, &Z0), OK);
+    assert_eq!(fmu.set(&state(), &Z0), OK);
     assert_eq!(fmu.step(DT), OK);
     assert_ne!(fmu.tau(), first);
     assert_eq!(fmu.tau(), [native[0].1[0], native[0].1[1]]);
@@ -241,16 +251,19 @@ fn tunable_parameters_are_followed_and_checked() {
     };
     assert_eq!(model(&fmu).e_ref, 14.0);
     assert_eq!(model(&fmu).weights.energy, 25.0, "w_E < 0: paper value");
-    assert_eq!(fmu.set(&[VR_E_REF, VR_W_E], &[8.0, 7.5]), OK);
+    assert_eq!(fmu.set(&[vref("E_ref"), vref("w_E")], &[8.0, 7.5]), OK);
     assert_eq!(model(&fmu).e_ref, 8.0);
     assert_eq!(model(&fmu).weights.energy, 7.5);
     assert_eq!(fmu.step(DT), OK);
     // out of range: refused, nothing changes, the old values stay readable;
     // fmi2Error puts the instance in the FMI error state until fmi2Reset
-    assert_eq!(fmu.set(&[VR_E_REF, VR_W_F], &[9.0, 0.0]), ERROR);
+    assert_eq!(fmu.set(&[vref("E_ref"), vref("w_F")], &[9.0, 0.0]), ERROR);
     assert!(fmu.instance.log.contains(&["w_F = 0 is below its minimum"]));
     assert_eq!(model(&fmu).e_ref, 8.0);
-    assert_eq!((fmu.real(VR_E_REF), fmu.real(VR_W_F)), (8.0, 225.0));
+    assert_eq!(
+        (fmu.real(vref("E_ref")), fmu.real(vref("w_F"))),
+        (8.0, 225.0)
+    );
     assert_eq!(fmu.step(DT), ERROR);
     assert!(
         fmu.instance
@@ -261,11 +274,15 @@ fn tunable_parameters_are_followed_and_checked() {
         assert_eq!(fmi2Reset(fmu.c), OK);
         assert_eq!(fmi2EnterInitializationMode(fmu.c), OK);
     }
-    assert_eq!(fmu.real(VR_E_REF), 14.0, "reset: start values");
+    assert_eq!(fmu.real(vref("E_ref")), 14.0, "reset: start values");
 
     let mut fmu = Fmu::start(&[], &[], Z0);
     assert_eq!(fmu.step(DT), OK);
-    assert_eq!(fmu.set(&[VR_TAU_MAX], &[2.0]), ERROR, "fixed in step mode");
+    assert_eq!(
+        fmu.set(&[vref("tau_max")], &[2.0]),
+        ERROR,
+        "fixed in step mode"
+    );
     assert!(
         fmu.instance
             .log
@@ -276,15 +293,19 @@ fn tunable_parameters_are_followed_and_checked() {
 #[test]
 fn invalid_parameters_are_rejected_with_a_message() {
     for (vr, v, needle) in [
-        (VR_E_REF, -1.0, "E_ref = -1 is below its minimum"),
+        (vref("E_ref"), -1.0, "E_ref = -1 is below its minimum"),
         (
-            VR_SAMPLE_PERIOD,
+            vref("sample_period"),
             0.0,
             "sample_period = 0 is below its minimum",
         ),
-        (VR_M1, f64::NAN, "m[1] = NaN is not a finite number"),
-        (VR_C1, 2.0, "c[1] = 2 is above its maximum"),
-        (VR_Q1, f64::INFINITY, "q[1] = inf is not a finite number"),
+        (vref("m[1]"), f64::NAN, "m[1] = NaN is not a finite number"),
+        (vref("c[1]"), 2.0, "c[1] = 2 is above its maximum"),
+        (
+            vref("q[1]"),
+            f64::INFINITY,
+            "q[1] = inf is not a finite number",
+        ),
     ] {
         let fmu = Fmu::instantiate();
         assert_eq!(fmu.set(&[vr], &[v]), ERROR);
@@ -295,17 +316,17 @@ fn invalid_parameters_are_rejected_with_a_message() {
         );
     }
     let fmu = Fmu::instantiate();
-    assert_eq!(fmu.set_int(&[VR_VARIANT], &[3]), ERROR);
+    assert_eq!(fmu.set_int(&[vref("variant")], &[3]), ERROR);
     assert!(
         fmu.instance
             .log
             .contains(&["variant = 3 is above its maximum"])
     );
     assert_eq!(unsafe { fmi2Reset(fmu.c) }, OK);
-    assert_eq!(fmu.set_int(&[VR_HORIZON], &[0]), ERROR);
+    assert_eq!(fmu.set_int(&[vref("horizon")], &[0]), ERROR);
     // relations checked at exitInitializationMode
     let fmu = Fmu::instantiate();
-    assert_eq!(fmu.set(&[VR_C1, VR_C2], &[0.0, 0.0]), OK);
+    assert_eq!(fmu.set(&[vref("c[1]"), vref("c[2]")], &[0.0, 0.0]), OK);
     unsafe {
         assert_eq!(fmi2EnterInitializationMode(fmu.c), OK);
         assert_eq!(fmi2ExitInitializationMode(fmu.c), ERROR);
@@ -319,7 +340,7 @@ fn invalid_parameters_are_rejected_with_a_message() {
 
 #[test]
 fn straight_variant_uses_its_paper_weight() {
-    let fmu = Fmu::start(&[], &[(VR_VARIANT, VARIANT_STRAIGHT)], Z0);
+    let fmu = Fmu::start(&[], &[(vref("variant"), VARIANT_STRAIGHT)], Z0);
     let instance = unsafe { &*(fmu.c as *const fmi2_slave::Instance<EigenMpcFmu>) };
     let controller = instance.model().unwrap().controller();
     assert_eq!(controller.config().cost.weights.energy, 5.0);
@@ -333,10 +354,10 @@ fn a_failed_solve_returns_the_fallback_with_its_status() {
     // A state so fast that the prediction overflows: the QP data are not
     // finite and the QP fails; the FMU logs and holds a bounded torque.
     let mut fmu = Fmu::start(&[], &[], Z0);
-    assert_eq!(fmu.set(&STATE, &[0.1, 0.1, 1e155, -1e155]), OK);
+    assert_eq!(fmu.set(&state(), &[0.1, 0.1, 1e155, -1e155]), OK);
     let status = fmu.step(DT);
     assert_eq!(status, WARNING, "{:?}", fmu.instance.log.lines());
-    let code = fmu.integer(VR_SOLVER_STATUS);
+    let code = fmu.integer(vref("solver_status"));
     assert_eq!(code, STATUS_QP_FAILED);
     assert!(fmu.instance.log.contains(&["QP failed"]));
     let tau = fmu.tau();
@@ -348,12 +369,12 @@ fn a_failed_solve_returns_the_fallback_with_its_status() {
 #[test]
 fn the_controller_recovers_after_a_failed_solve() {
     let mut fmu = Fmu::start(&[], &[], Z0);
-    assert_eq!(fmu.set(&STATE, &[0.1, 0.1, 1e155, -1e155]), OK);
+    assert_eq!(fmu.set(&state(), &[0.1, 0.1, 1e155, -1e155]), OK);
     assert_eq!(fmu.step(DT), WARNING);
-    assert_eq!(fmu.integer(VR_SOLVER_STATUS), STATUS_QP_FAILED);
-    assert_eq!(fmu.set(&STATE, &Z0), OK);
+    assert_eq!(fmu.integer(vref("solver_status")), STATUS_QP_FAILED);
+    assert_eq!(fmu.set(&state(), &Z0), OK);
     assert_eq!(fmu.step(DT), OK, "{:?}", fmu.instance.log.lines());
-    assert_eq!(fmu.integer(VR_SOLVER_STATUS), STATUS_SOLVED);
+    assert_eq!(fmu.integer(vref("solver_status")), STATUS_SOLVED);
     assert!(fmu.tau().iter().all(|t| t.is_finite() && t.abs() <= 1.0));
 }
 
@@ -371,7 +392,8 @@ fn status_codes_match_the_controller() {
 #[test]
 fn default_chart_and_eigenvector_are_the_14_j_in_phase_mode() {
     let system = DoublePendulum::default();
-    let (mode, chart) = mode_and_chart::<_, 2, 4>(&system, 0, 14.0, FMU_CHART_DEGREE).unwrap();
+    let (mode, chart) =
+        mode_and_chart::<_, 2, 4>(&system, 0, 14.0, CHART_COEFFICIENTS - 1).unwrap();
     let d = EigenMpcFmu::description();
     let start = |name: &str| match d.variable(name).unwrap().start {
         Some(Value::Real(x)) => x,
@@ -386,7 +408,7 @@ fn default_chart_and_eigenvector_are_the_14_j_in_phase_mode() {
     assert_eq!(start("E_ref"), 14.0);
     let coefficients: [Vec<f64>; 2] = std::array::from_fn(|j| {
         (0..CHART_COEFFICIENTS)
-            .map(|k| start(&fmu_chart_coef_name(j + 1, k)))
+            .map(|k| start(&format!("chart.coef[{},{k}]", j + 1)))
             .collect()
     });
     // Coefficients agree to fitting noise (the even ones are ~1e-12 noise);

@@ -60,6 +60,14 @@ unsafe impl GlobalAlloc for CountingAllocator {
 #[global_allocator]
 static ALLOCATOR: CountingAllocator = CountingAllocator;
 
+/// Value reference of `name` in the FMU's variable table.
+fn vref(name: &str) -> u32 {
+    EigenMpcFmu::description()
+        .variable(name)
+        .unwrap_or_else(|| panic!("no variable {name}"))
+        .value_reference
+}
+
 /// Runs `f` with counting on; returns its result and the allocations it made.
 fn counted<T>(f: impl FnOnce() -> T) -> (T, usize) {
     ALLOCATIONS.with(|n| n.set(0));
@@ -97,9 +105,14 @@ fn fmu_sample_path_does_not_allocate() {
     let callbacks = Box::new(log.callbacks());
     let name = CString::new("no_alloc").unwrap();
     let guid = CString::new(xml::guid(&EigenMpcFmu::description())).unwrap();
-    let state_vr = [VR_Q1, VR_Q2, VR_QD1, VR_QD2];
-    let out_vr = [VR_TAU1, VR_TAU2, VR_ENERGY, VR_SOLVE_TIME];
-    let int_vr = [VR_QP_ITERATIONS, VR_SOLVER_STATUS];
+    let state_vr = [vref("q[1]"), vref("q[2]"), vref("qd[1]"), vref("qd[2]")];
+    let out_vr = [
+        vref("tau[1]"),
+        vref("tau[2]"),
+        vref("energy"),
+        vref("solve_time"),
+    ];
+    let int_vr = [vref("qp_iterations"), vref("solver_status")];
     let mut z = SVector::<f64, 4>::from(Z0);
     unsafe {
         let c = fmi2Instantiate(

@@ -10,6 +10,9 @@
 //!   [`Model`] trait a model implements;
 //! - [`logger`]: the host's logger callback with the categories
 //!   `logStatusError`, `logStatusWarning`, `logEvents`, `logAll`;
+//! - [`table`]: declarative tables parameterised by the number of joints,
+//!   from which the variables, value references, settings, C constants and
+//!   Markdown tables follow;
 //! - [`abi`]: the C entry points, generic over the model, with null checks
 //!   and `catch_unwind` (no panic crosses the C ABI);
 //! - [`export_fmi2!`]: generates all 34 FMI 2.0 common + Co-Simulation
@@ -26,6 +29,7 @@ pub mod abi;
 mod export;
 pub mod instance;
 pub mod logger;
+pub mod table;
 pub mod testing;
 pub mod values;
 pub mod variables;

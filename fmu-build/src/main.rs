@@ -5,8 +5,11 @@
 //! `modelDescription.xml` from its variable table (also into the checked-in
 //! `modelDescription/`), zips `target/fmu/<modelIdentifier>.fmu`
 //! (`modelDescription.xml`, `binaries/linux64/<modelIdentifier>.so`,
-//! `documentation/index.html`) and generates `include/eigenmpc.h` with
-//! cbindgen (config `cbindgen.toml`) next to the standard FMI 2.0 headers.
+//! `documentation/index.html`), generates `include/eigenmpc.h` (the plain C
+//! API with cbindgen, config `cbindgen.toml`, and every FMU's value-reference
+//! and enumeration constants from its variable table) next to the standard
+//! FMI 2.0 headers, and rewrites the README's FMU variable tables from the
+//! variable tables.
 //!
 //! Adding an FMU is one entry in [`FMUS`].
 
@@ -28,9 +31,11 @@ struct FmuSpec {
     library: &'static str,
     /// Binary of the package that writes modelDescription.xml and index.html.
     describe: &'static str,
-    /// Prefix of the crate's public items (value references, constants) in
-    /// the C header.
+    /// Prefix of the FMU's constants (value references, enumeration items,
+    /// a C API's constants) in the C header.
     header_prefix: &'static str,
+    /// Whether the crate has a plain C API for cbindgen.
+    c_api: bool,
     /// Items that keep their name in the header (a plain C API's types).
     header_unprefixed: &'static [&'static str],
 }
@@ -44,6 +49,7 @@ const FMUS: &[FmuSpec] = &[
         library: "libdouble_pendulum_fmu.so",
         describe: "double-pendulum-describe",
         header_prefix: "DOUBLE_PENDULUM_",
+        c_api: false,
         header_unprefixed: &[],
     },
     FmuSpec {
@@ -53,8 +59,29 @@ const FMUS: &[FmuSpec] = &[
         library: "libeigenmpc_fmu.so",
         describe: "eigenmpc-describe",
         header_prefix: "EIGENMPC_",
+        c_api: true,
         // The plain C API (controller-fmu/src/capi.rs) keeps its names.
         header_unprefixed: &["EigenMpc", "EigenMpcConfig", "EigenMpcStepInfo"],
+    },
+    FmuSpec {
+        model_identifier: "TriplePendulum",
+        package: "triple-pendulum-fmu",
+        dir: "plant3",
+        library: "libtriple_pendulum_fmu.so",
+        describe: "triple-pendulum-describe",
+        header_prefix: "TRIPLE_PENDULUM_",
+        c_api: false,
+        header_unprefixed: &[],
+    },
+    FmuSpec {
+        model_identifier: "EigenMPC3",
+        package: "eigenmpc3-fmu",
+        dir: "controller3-fmu",
+        library: "libeigenmpc3_fmu.so",
+        describe: "eigenmpc3-describe",
+        header_prefix: "EIGENMPC3_",
+        c_api: false,
+        header_unprefixed: &[],
     },
 ];
 
@@ -202,7 +229,8 @@ fn header(ws: &Workspace) -> Result<PathBuf> {
     }
     let out = include.join("eigenmpc.h");
     let mut text = Vec::new();
-    for (i, fmu) in FMUS.iter().enumerate() {
+    let mut first = true;
+    for fmu in FMUS.iter().filter(|f| f.c_api) {
         let mut config = cbindgen::Config::from_file(ws.root.join("cbindgen.toml"))
             .map_err(|e| anyhow::anyhow!("cbindgen.toml: {e}"))?;
         config.export.prefix = Some(fmu.header_prefix.into());
@@ -213,7 +241,7 @@ fn header(ws: &Workspace) -> Result<PathBuf> {
                 .insert(name.to_string(), name.to_string());
         }
         config.export.renaming_overrides_prefixing = true;
-        if i > 0 {
+        if !first {
             // One include guard and preamble for the whole header.
             config.include_guard = None;
             config.header = None;
@@ -221,6 +249,7 @@ fn header(ws: &Workspace) -> Result<PathBuf> {
             config.includes.clear();
             config.no_includes = true;
         }
+        first = false;
         let bindings = cbindgen::Builder::new()
             .with_config(config)
             .with_crate(ws.root.join(fmu.dir))
@@ -228,8 +257,35 @@ fn header(ws: &Workspace) -> Result<PathBuf> {
             .map_err(|e| anyhow::anyhow!("cbindgen on {}: {e}", fmu.package))?;
         bindings.write(&mut text);
     }
+    let mut text = String::from_utf8(text)?;
+    // The value references and enumeration items, from the variable tables,
+    // inside the include guard.
+    let guard_end = text
+        .rfind("#endif")
+        .context("no include guard in the cbindgen output")?;
+    let mut defines = String::from("\n");
+    for fmu in FMUS {
+        defines.push_str(
+            &eigenmpc_fmu_models::products::c_defines(fmu.model_identifier, fmu.header_prefix)
+                .map_err(|e| anyhow::anyhow!(e))?,
+        );
+        defines.push('\n');
+    }
+    text.insert_str(guard_end, &defines);
     std::fs::write(&out, text)?;
     Ok(out)
+}
+
+/// Rewrites the README's FMU variable tables; true if they changed.
+fn update_readme(ws: &Workspace) -> Result<bool> {
+    let path = ws.root.join("README.md");
+    let old = std::fs::read_to_string(&path)?;
+    let new = eigenmpc_fmu_models::readme::update(&old).map_err(|e| anyhow::anyhow!(e))?;
+    if new == old {
+        return Ok(false);
+    }
+    std::fs::write(&path, new)?;
+    Ok(true)
 }
 
 fn main() -> Result<()> {
@@ -249,5 +305,8 @@ fn main() -> Result<()> {
     }
     let h = header(&ws)?;
     println!("wrote {}", h.display());
+    if update_readme(&ws)? {
+        println!("updated the FMU variable tables of README.md: commit it");
+    }
     Ok(())
 }

@@ -13,7 +13,23 @@ use std::ptr;
 
 const OK: ffi::fmi2Status = ffi::fmi2Status_fmi2OK;
 const ERROR: ffi::fmi2Status = ffi::fmi2Status_fmi2Error;
-const OUTPUTS: [u32; 5] = [VR_Q1, VR_Q2, VR_QD1, VR_QD2, VR_ENERGY];
+/// Value reference of `name` in the FMU's variable table.
+fn vref(name: &str) -> u32 {
+    DoublePendulumFmu::description()
+        .variable(name)
+        .unwrap_or_else(|| panic!("no variable {name}"))
+        .value_reference
+}
+
+fn outputs_vr() -> [u32; 5] {
+    [
+        vref("q[1]"),
+        vref("q[2]"),
+        vref("qd[1]"),
+        vref("qd[2]"),
+        vref("energy"),
+    ]
+}
 
 struct Fmu {
     c: ffi::fmi2Component,
@@ -52,7 +68,7 @@ impl Fmu {
     fn outputs(&self) -> [f64; 5] {
         let mut v = [f64::NAN; 5];
         assert_eq!(
-            unsafe { fmi2GetReal(self.c, OUTPUTS.as_ptr(), 5, v.as_mut_ptr()) },
+            unsafe { fmi2GetReal(self.c, outputs_vr().as_ptr(), 5, v.as_mut_ptr()) },
             OK
         );
         v
@@ -75,16 +91,18 @@ impl Drop for Fmu {
     }
 }
 
-const SWING: [(u32, f64); 4] = [
-    (VR_Q0_1, 1.2),
-    (VR_Q0_2, -0.7),
-    (VR_QD0_1, 0.5),
-    (VR_QD0_2, 1.5),
-];
+fn swing() -> [(u32, f64); 4] {
+    [
+        (vref("q0[1]"), 1.2),
+        (vref("q0[2]"), -0.7),
+        (vref("qd0[1]"), 0.5),
+        (vref("qd0[2]"), 1.5),
+    ]
+}
 
 #[test]
 fn free_run_of_60_s_conserves_energy() {
-    let mut fmu = Fmu::start(&SWING);
+    let mut fmu = Fmu::start(&swing());
     let e0 = fmu.outputs()[4];
     // E0 from the paper's formula: V = g (m1 + m2) l1 (1 - cos q1) + g m2 l2 (1 - cos(q1 + q2)), T = 1/2 qd'M qd
     let (q1, q2, w1, w2) = (1.2f64, -0.7f64, 0.5f64, 1.5f64);
@@ -108,8 +126,8 @@ fn free_run_of_60_s_conserves_energy() {
 
 #[test]
 fn result_does_not_depend_on_the_communication_step() {
-    let mut fine = Fmu::start(&SWING);
-    let mut coarse = Fmu::start(&SWING);
+    let mut fine = Fmu::start(&swing());
+    let mut coarse = Fmu::start(&swing());
     for _ in 0..200 {
         fine.step(0.005);
     }
@@ -130,7 +148,7 @@ fn result_does_not_depend_on_the_communication_step() {
 #[test]
 fn energy_gain_equals_the_work_of_piecewise_constant_torques() {
     // dE/dt = tau . qd, so with tau held over a step: dE = tau . dq exactly.
-    let mut fmu = Fmu::start(&SWING);
+    let mut fmu = Fmu::start(&swing());
     let e0 = fmu.outputs()[4];
     let mut work = 0.0;
     for k in 0..500 {
@@ -138,7 +156,7 @@ fn energy_gain_equals_the_work_of_piecewise_constant_torques() {
             3.0 * (0.37 * k as f64).sin(),
             -2.0 * (0.23 * k as f64).cos(),
         ];
-        assert_eq!(fmu.set(&[VR_TAU1, VR_TAU2], &tau), OK);
+        assert_eq!(fmu.set(&[vref("tau[1]"), vref("tau[2]")], &tau), OK);
         let before = fmu.outputs();
         fmu.step(0.01);
         let after = fmu.outputs();
@@ -155,7 +173,12 @@ fn energy_gain_equals_the_work_of_piecewise_constant_torques() {
 
 #[test]
 fn damping_dissipates_energy() {
-    let mut fmu = Fmu::start(&[SWING[0], SWING[1], (VR_DAMPING1, 0.2), (VR_DAMPING2, 0.1)]);
+    let mut fmu = Fmu::start(&[
+        swing()[0],
+        swing()[1],
+        (vref("damping[1]"), 0.2),
+        (vref("damping[2]"), 0.1),
+    ]);
     let mut e = fmu.outputs()[4];
     for _ in 0..100 {
         fmu.step(0.05);
@@ -163,19 +186,19 @@ fn damping_dissipates_energy() {
         assert!(e_next <= e + 1e-12, "energy rose: {e} -> {e_next}");
         e = e_next;
     }
-    assert!(e < 0.7 * Fmu::start(&SWING[..2]).outputs()[4]);
+    assert!(e < 0.7 * Fmu::start(&swing()[..2]).outputs()[4]);
 }
 
 #[test]
 fn parameters_scale_the_model() {
     // Hanging at rest with q0 = (pi/2, 0): V = g (m1 + m2) l1 + g m2 l2
     let fmu = Fmu::start(&[
-        (VR_Q0_1, std::f64::consts::FRAC_PI_2),
-        (VR_M1, 2.0),
-        (VR_M2, 0.5),
-        (VR_L1, 1.5),
-        (VR_L2, 0.8),
-        (VR_G, 3.0),
+        (vref("q0[1]"), std::f64::consts::FRAC_PI_2),
+        (vref("m[1]"), 2.0),
+        (vref("m[2]"), 0.5),
+        (vref("l[1]"), 1.5),
+        (vref("l[2]"), 0.8),
+        (vref("g"), 3.0),
     ]);
     let expected = 3.0 * 2.5 * 1.5 + 3.0 * 0.5 * 0.8;
     assert!((fmu.outputs()[4] - expected).abs() < 1e-12);
@@ -184,17 +207,17 @@ fn parameters_scale_the_model() {
 #[test]
 fn invalid_parameters_and_inputs_are_rejected() {
     for (vr, v, needle) in [
-        (VR_M1, 0.0, "m[1] = 0 is below its minimum"),
-        (VR_L2, -1.0, "l[2] = -1 is below its minimum"),
-        (VR_G, f64::NAN, "g = NaN is not a finite number"),
-        (VR_RTOL, 1.0, "rtol = 1 is above its maximum"),
+        (vref("m[1]"), 0.0, "m[1] = 0 is below its minimum"),
+        (vref("l[2]"), -1.0, "l[2] = -1 is below its minimum"),
+        (vref("g"), f64::NAN, "g = NaN is not a finite number"),
+        (vref("rtol"), 1.0, "rtol = 1 is above its maximum"),
         (
-            VR_TAU1,
+            vref("tau[1]"),
             f64::INFINITY,
             "tau[1] = inf is not a finite number",
         ),
         (
-            VR_Q0_1,
+            vref("q0[1]"),
             f64::NEG_INFINITY,
             "q0[1] = -inf is not a finite number",
         ),
@@ -210,13 +233,13 @@ fn invalid_parameters_and_inputs_are_rejected() {
     let mut fmu = Fmu::start(&[]);
     fmu.step(0.1);
     assert_eq!(
-        fmu.set(&[VR_M1], &[2.0]),
+        fmu.set(&[vref("m[1]")], &[2.0]),
         ERROR,
         "fixed parameter in step mode"
     );
     let mut fmu = Fmu::start(&[]);
     fmu.step(0.1);
-    assert_eq!(fmu.set(&[VR_ENERGY], &[2.0]), ERROR, "output");
+    assert_eq!(fmu.set(&[vref("energy")], &[2.0]), ERROR, "output");
     assert!(
         fmu.instance
             .log
@@ -242,7 +265,7 @@ fn loaded_library_runs_like_the_linked_model() {
     let callbacks = log.callbacks();
     let name = CString::new("loaded").unwrap();
     let guid = CString::new(xml::guid(&DoublePendulumFmu::description())).unwrap();
-    let mut linked = Fmu::start(&SWING);
+    let mut linked = Fmu::start(&swing());
     unsafe {
         let instantiate = lib.fmi2Instantiate.as_ref().unwrap();
         let c = instantiate(
@@ -256,7 +279,7 @@ fn loaded_library_runs_like_the_linked_model() {
         );
         assert!(!c.is_null());
         let set = lib.fmi2SetReal.as_ref().unwrap();
-        for (vr, v) in SWING {
+        for (vr, v) in swing() {
             assert_eq!(set(c, &vr, 1, &v), OK);
         }
         assert_eq!(lib.fmi2EnterInitializationMode.as_ref().unwrap()(c), OK);
@@ -270,7 +293,7 @@ fn loaded_library_runs_like_the_linked_model() {
         }
         let mut v = [0.0; 5];
         assert_eq!(
-            lib.fmi2GetReal.as_ref().unwrap()(c, OUTPUTS.as_ptr(), 5, v.as_mut_ptr()),
+            lib.fmi2GetReal.as_ref().unwrap()(c, outputs_vr().as_ptr(), 5, v.as_mut_ptr()),
             OK
         );
         assert_eq!(v, linked.outputs());
@@ -294,4 +317,250 @@ fn checked_in_model_description_matches_the_table() {
         "{} is out of date with the variable table: run `cargo run -p fmu-build` and commit it",
         path.display()
     );
+}
+
+/// The identified laboratory pendulum of `shared/robots/lab-double-pendulum-A0.yml`
+/// (inertias about the joints, geared motors, viscous and Coulomb friction)
+/// plus springs with rest angles: every rigid-link parameter reaches the model.
+fn robot_a0() -> Vec<(&'static str, f64)> {
+    vec![
+        ("m[1]", 0.5593806151425046),
+        ("m[2]", 0.6043459469186889),
+        ("l[1]", 0.3),
+        ("l[2]", 0.2),
+        ("r[1]", 0.3),
+        ("r[2]", 0.18377686083653508),
+        ("I[1]", 0.053470810264216295),
+        ("I[2]", 0.02392374528789766),
+        ("Ir[1]", 7.659297952841183e-05),
+        ("Ir[2]", 7.659297952841183e-05),
+        ("gr[1]", 6.0),
+        ("gr[2]", 6.0),
+        ("b[1]", 0.001),
+        ("b[2]", 0.001),
+        ("cf[1]", 0.093),
+        ("cf[2]", 0.078),
+        ("k[1]", 0.3),
+        ("k[2]", 0.2),
+        ("q_rest[1]", 0.1),
+        ("q_rest[2]", -0.2),
+        ("g", 9.81),
+        ("coulomb_sharpness", 50.0),
+    ]
+}
+
+fn a0_params() -> eigenmpc::mechanics::PlanarChainParams<2> {
+    use eigenmpc::mechanics::{Joint, Link, PlanarChainParams};
+    let joint = |b, cf, k, rest| Joint {
+        rotor_inertia: 7.659297952841183e-05,
+        gear_ratio: 6.0,
+        viscous: b,
+        coulomb: cf,
+        stiffness: k,
+        rest_angle: rest,
+    };
+    PlanarChainParams {
+        links: [
+            Link::with_inertia_about_joint(0.5593806151425046, 0.3, 0.3, 0.053470810264216295),
+            Link::with_inertia_about_joint(
+                0.6043459469186889,
+                0.2,
+                0.18377686083653508,
+                0.02392374528789766,
+            ),
+        ],
+        joints: [
+            joint(0.001, 0.093, 0.3, 0.1),
+            joint(0.001, 0.078, 0.2, -0.2),
+        ],
+        gravity: 9.81,
+        coulomb_sharpness: 50.0,
+    }
+}
+
+#[test]
+fn rigid_link_parameters_give_the_core_model() {
+    use eigenmpc::integrate::{Tolerances, simulate_accurate};
+    use eigenmpc::mechanics::{PlanarChain, Vector};
+    let mut params: Vec<(u32, f64)> = robot_a0().iter().map(|&(n, v)| (vref(n), v)).collect();
+    params.extend(swing());
+    let mut fmu = Fmu::start(&params);
+    let tau = [0.05, -0.03];
+    assert_eq!(fmu.set(&[vref("tau[1]"), vref("tau[2]")], &tau), OK);
+    let system = PlanarChain::new(a0_params()).unwrap();
+    let z0 = nalgebra::SVector::<f64, 4>::from([1.2, -0.7, 0.5, 1.5]);
+    // energy at t = 0 is the core's (rotor inertia, COM, springs, V(q_eq) = 0)
+    let e0 = eigenmpc::mechanics::state_energy::<_, 2, 4>(&system, &z0);
+    assert!(
+        (fmu.outputs()[4] - e0).abs() < 1e-14,
+        "{} vs {e0}",
+        fmu.outputs()[4]
+    );
+    for _ in 0..100 {
+        fmu.step(0.01);
+    }
+    let z = simulate_accurate::<_, 2, 4>(
+        &system,
+        &z0,
+        &Vector::<2>::from(tau),
+        1.0,
+        Tolerances::default(),
+    )
+    .unwrap();
+    let out = fmu.outputs();
+    println!("A0 robot, 1 s: FMU {out:?}, core {z:?}");
+    for k in 0..4 {
+        assert!(
+            (out[k] - z[k]).abs() < 1e-9,
+            "state {k}: {} vs {}",
+            out[k],
+            z[k]
+        );
+    }
+    // friction took energy: well below the swing's
+    assert!(out[4] < e0);
+}
+
+#[test]
+fn damping_is_an_alias_of_the_viscous_friction() {
+    let run = |params: &[(&str, f64)]| {
+        let mut p: Vec<(u32, f64)> = params.iter().map(|&(n, v)| (vref(n), v)).collect();
+        p.extend(swing());
+        let mut fmu = Fmu::start(&p);
+        for _ in 0..100 {
+            fmu.step(0.05);
+        }
+        fmu.outputs()
+    };
+    let by_b = run(&[("b[1]", 0.2), ("b[2]", 0.1)]);
+    let by_damping = run(&[("damping[1]", 0.2), ("damping[2]", 0.1)]);
+    let both_equal = run(&[("damping[1]", 0.2), ("b[1]", 0.2), ("b[2]", 0.1)]);
+    assert_eq!(by_b, by_damping);
+    assert_eq!(by_b, both_equal);
+    assert!(by_b[4] < 0.7 * Fmu::start(&swing()).outputs()[4]);
+    // both set to different values: refused at initialization, naming both
+    let fmu = Fmu::instantiate();
+    assert_eq!(
+        fmu.set(&[vref("b[2]"), vref("damping[2]")], &[0.1, 0.3]),
+        OK
+    );
+    unsafe {
+        assert_eq!(fmi2EnterInitializationMode(fmu.c), OK);
+        assert_eq!(fmi2ExitInitializationMode(fmu.c), ERROR);
+    }
+    assert!(
+        fmu.instance.log.contains(&[
+            "fmi2ExitInitializationMode",
+            "b[2] = 0.1 and damping[2] = 0.3"
+        ]),
+        "{:?}",
+        fmu.instance.log.lines()
+    );
+}
+
+#[test]
+fn non_physical_rigid_links_are_refused_naming_the_parameter() {
+    // range: refused when set, naming the variable
+    for (name, v, needle) in [
+        ("I[1]", -2.0, "I[1] = -2 is below its minimum"),
+        ("gr[2]", 0.0, "gr[2] = 0 is below its minimum"),
+        ("cf[1]", -0.1, "cf[1] = -0.1 is below its minimum"),
+        (
+            "coulomb_sharpness",
+            0.0,
+            "coulomb_sharpness = 0 is below its minimum",
+        ),
+    ] {
+        let fmu = Fmu::instantiate();
+        assert_eq!(fmu.set(&[vref(name)], &[v]), ERROR);
+        assert!(
+            fmu.instance.log.contains(&[needle]),
+            "{:?}",
+            fmu.instance.log.lines()
+        );
+    }
+    // relations: at fmi2ExitInitializationMode with the core's reason
+    for (params, needles) in [
+        (
+            vec![("r[2]", 0.0)],
+            vec!["model parameter I[2] = 0 is invalid"],
+        ),
+        (
+            // an inertia about the joint far below m r^2: M(q) not positive definite
+            vec![("r[2]", 1.0), ("I[2]", 1e-6)],
+            vec![
+                "model parameter I[2] = 0.00000100",
+                "M(q) is not positive definite",
+            ],
+        ),
+        (vec![("g", 0.0)], vec!["no stable equilibrium"]),
+    ] {
+        let needles = [vec!["fmi2ExitInitializationMode"], needles].concat();
+        let fmu = Fmu::instantiate();
+        for (n, v) in params {
+            assert_eq!(fmu.set(&[vref(n)], &[v]), OK);
+        }
+        unsafe {
+            assert_eq!(fmi2EnterInitializationMode(fmu.c), OK);
+            assert_eq!(fmi2ExitInitializationMode(fmu.c), ERROR, "{needles:?}");
+        }
+        assert!(
+            fmu.instance.log.contains(&needles),
+            "{needles:?}: {:?}",
+            fmu.instance.log.lines()
+        );
+    }
+}
+
+/// Issue 8: the plant starts from rest (q0 = qd0 = 0) under a nonzero or
+/// saturated torque for every tolerance it accepts: the first fmi2DoStep
+/// returns fmi2OK, and the state agrees with a tight reference run to the
+/// requested accuracy.
+#[test]
+fn starts_from_rest_for_every_accepted_tolerance() {
+    let d = DoublePendulumFmu::description();
+    let (lo, hi) = {
+        let v = d.variable("rtol").unwrap();
+        (v.min.unwrap(), v.max.unwrap())
+    };
+    assert_eq!((lo, hi), (1e-14, 1e-2));
+    assert_eq!(d.variable("atol").unwrap().min, Some(lo));
+    assert_eq!(d.variable("atol").unwrap().max, Some(hi));
+    let tolerances = [lo, 1e-12, 1e-8, hi];
+    let tau_vr = [vref("tau[1]"), vref("tau[2]")];
+    let mut worst: f64 = 0.0;
+    for tau in [[1.0, -1.0], [1.0, 1.0], [1e-6, 0.0], [0.0, -1e3]] {
+        let mut reference = Fmu::start(&[(vref("rtol"), 1e-13), (vref("atol"), 1e-14)]);
+        assert_eq!(reference.set(&tau_vr, &tau), OK);
+        reference.step(0.025);
+        let want = reference.outputs();
+        for rtol in tolerances {
+            for atol in tolerances {
+                let fmu = Fmu::start(&[(vref("rtol"), rtol), (vref("atol"), atol)]);
+                assert_eq!(fmu.set(&tau_vr, &tau), OK);
+                let status = unsafe { fmi2DoStep(fmu.c, 0.0, 0.025, 1) };
+                assert_eq!(
+                    status,
+                    OK,
+                    "tau {tau:?}, rtol {rtol}, atol {atol}: {:?}",
+                    fmu.instance.log.lines()
+                );
+                let got = fmu.outputs();
+                for k in 0..4 {
+                    let err = (got[k] - want[k]).abs();
+                    let allowed = 10.0 * (rtol * want[k].abs() + atol) + 1e-13 * want[k].abs();
+                    worst = worst.max(err / allowed);
+                    assert!(
+                        err <= allowed,
+                        "tau {tau:?}, rtol {rtol}, atol {atol}, state {k}: {} vs {}",
+                        got[k],
+                        want[k]
+                    );
+                }
+                // it moved the way the torque pushes
+                assert!(got[2] * tau[0] + got[3] * tau[1] > 0.0);
+            }
+        }
+    }
+    println!("start from rest: worst error / allowed = {worst:.2e}");
 }

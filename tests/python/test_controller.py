@@ -34,7 +34,9 @@ def test_model_description(controller_md):
     # at a communication point do not change the outputs there
     assert all(u.dependencies == [] for u in controller_md.outputs)
     initial = {u.variable.name: u.dependencies for u in controller_md.initialUnknowns}
-    assert sorted(d.name for d in initial["energy"]) == sorted(STATE + ["m[1]", "m[2]", "l[1]", "l[2]", "g"])
+    # the energy depends on the state and the model's inertia and potential, not on friction or tuning
+    model = [f"{p}[{j}]" for p in ["m", "l", "r", "I", "Ir", "gr", "k", "q_rest"] for j in (1, 2)] + ["g"]
+    assert sorted(d.name for d in initial["energy"]) == sorted(STATE + model)
     for name in ["E_ref", "alpha", "beta", "w_E", "w_x", "w_xd", "w_F"]:
         assert v[name].variability == "tunable", name
     for name in ["tau_max", "horizon", "sample_period", "m[1]", "g", "c[2]", "chart.coef[2,9]"]:

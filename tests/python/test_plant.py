@@ -28,7 +28,8 @@ def test_model_structure(plant_md):
     initial = {u.variable.name: sorted(d.name for d in u.dependencies) for u in plant_md.initialUnknowns}
     assert initial["q[1]"] == ["q0[1]"]
     assert initial["qd[2]"] == ["qd0[2]"]
-    assert "damping[1]" not in initial["energy"] and "g" in initial["energy"]
+    assert "damping[1]" not in initial["energy"] and "b[1]" not in initial["energy"]
+    assert "g" in initial["energy"] and "I[2]" in initial["energy"] and "Ir[1]" in initial["energy"]
     assert names["tau[1]"].causality == "input" and names["tau[1]"].unit == "N.m"
     assert names["m[1]"].variability == "fixed" and float(names["m[1]"].min) > 0
 

@@ -3,6 +3,6 @@
 
 fn main() -> std::process::ExitCode {
     fmi2_slave::xml::describe_main::<double_pendulum_fmu::DoublePendulumFmu>(
-        double_pendulum_fmu::DOCUMENTATION_HTML,
+        &double_pendulum_fmu::documentation_html(),
     )
 }

@@ -1,0 +1,936 @@
+//! Declarative variable tables parameterised by the number of joints `n`
+//! (Reference-FMUs style: the table is the single source of truth).
+//!
+//! A [`Table`] is a list of [`Row`]s. A row is one quantity (`q`, `E_ref`,
+//! `chart.coef`) with a [`Shape`] that expands it to one scalar variable
+//! (`E_ref`), one per joint (`q[1]`..`q[n]`) or one per joint and power
+//! (`chart.coef[j,k]`). From the table follow:
+//!
+//! - the value references, laid out by [`Table::new`]: per base type (Real,
+//!   Integer) the rows take consecutive references in table order, a row
+//!   marked [`Row::at`] starts its block at a fixed reference (so that a
+//!   table extended at the end keeps every earlier reference);
+//! - the [`Variable`]s of `modelDescription.xml` ([`Table::variables`]),
+//!   their start values taken from a default settings value `S` through the
+//!   rows' [`Field`] accessors;
+//! - the model's settings from the FMU's current values ([`Table::read`]);
+//! - a start-value list for a given settings value ([`Table::start_values`]);
+//! - the C header's value-reference constants ([`Table::c_defines`]) and a
+//!   Markdown variable table ([`markdown`]).
+//!
+//! Adding a parameter is one row: its name, shape, type, unit, range,
+//! description and the two accessors into the settings.
+
+use crate::values::Values;
+use crate::variables::{BaseType, EnumerationType, Value, Variability, Variable};
+use std::collections::HashSet;
+use std::fmt::Write;
+
+/// How many scalar variables a row expands to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shape {
+    /// One variable, `name`.
+    Scalar,
+    /// One per joint, `name[j]`, `j = 1..=n`.
+    Joints,
+    /// One per joint and power, `name[j,k]`, `j = 1..=n`, `k = 0..K`; value
+    /// reference `first + K (j - 1) + k`.
+    JointPowers(usize),
+}
+
+impl Shape {
+    /// Number of scalar variables for `n` joints.
+    pub fn len(self, n: usize) -> usize {
+        match self {
+            Shape::Scalar => 1,
+            Shape::Joints => n,
+            Shape::JointPowers(k) => n * k,
+        }
+    }
+
+    /// The elements in value-reference order.
+    pub fn elements(self, n: usize) -> Vec<Element> {
+        match self {
+            Shape::Scalar => vec![Element::default()],
+            Shape::Joints => (0..n).map(|j| Element { j, k: 0 }).collect(),
+            Shape::JointPowers(powers) => (0..n)
+                .flat_map(|j| (0..powers).map(move |k| Element { j, k }))
+                .collect(),
+        }
+    }
+
+    /// Offset of `e` from the row's first value reference.
+    pub fn offset(self, e: Element) -> usize {
+        match self {
+            Shape::Scalar => 0,
+            Shape::Joints => e.j,
+            Shape::JointPowers(powers) => powers * e.j + e.k,
+        }
+    }
+}
+
+/// One element of a row: joint `j` (0-based) and power `k`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Element {
+    /// Joint index, 0-based (`name[j + 1]`).
+    pub j: usize,
+    /// Power (only [`Shape::JointPowers`]).
+    pub k: usize,
+}
+
+/// The value type of a row.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Kind {
+    /// `fmi2Real`.
+    Real,
+    /// `fmi2Integer`.
+    Integer,
+    /// An enumeration (travels as `fmi2Integer`); its items bound the value.
+    Enumeration(EnumerationType),
+}
+
+impl Kind {
+    fn base(&self) -> BaseType {
+        match self {
+            Kind::Real => BaseType::Real,
+            Kind::Integer | Kind::Enumeration(_) => BaseType::Integer,
+        }
+    }
+}
+
+/// Accessors of a parameter row into the settings `S` (start values come
+/// from `get` on the defaults; the FMU's values go in through `set`).
+pub enum Field<S> {
+    /// A Real parameter.
+    Real {
+        /// Reads element `e` from the settings.
+        get: fn(&S, Element) -> f64,
+        /// Writes element `e` into the settings.
+        set: fn(&mut S, Element, f64),
+    },
+    /// An Integer or enumeration parameter.
+    Integer {
+        /// Reads element `e` from the settings.
+        get: fn(&S, Element) -> i32,
+        /// Writes element `e` into the settings.
+        set: fn(&mut S, Element, i32),
+    },
+}
+
+impl<S> Field<S> {
+    /// A Real field.
+    pub fn real(get: fn(&S, Element) -> f64, set: fn(&mut S, Element, f64)) -> Self {
+        Field::Real { get, set }
+    }
+
+    /// An Integer (or enumeration) field.
+    pub fn integer(get: fn(&S, Element) -> i32, set: fn(&mut S, Element, i32)) -> Self {
+        Field::Integer { get, set }
+    }
+
+    fn get(&self, s: &S, e: Element) -> Value {
+        match self {
+            Field::Real { get, .. } => Value::Real(get(s, e)),
+            Field::Integer { get, .. } => Value::Integer(get(s, e)),
+        }
+    }
+
+    fn set(&self, s: &mut S, e: Element, v: Value) {
+        match (self, v) {
+            (Field::Real { set, .. }, Value::Real(x)) => set(s, e, x),
+            (Field::Integer { set, .. }, Value::Integer(i)) => set(s, e, i),
+            // The plumbing stores values of the row's own type only.
+            _ => {}
+        }
+    }
+}
+
+/// What the host does with a row.
+pub enum Role<S> {
+    /// Set by the master every communication step; the model reads it.
+    Input {
+        /// Start value.
+        start: f64,
+    },
+    /// Computed by the model. No direct feedthrough within a step.
+    Output {
+        /// `Continuous` or `Discrete` (changes only at communication points).
+        variability: Variability,
+    },
+    /// A parameter held in the settings.
+    Parameter {
+        /// May change between communication steps.
+        tunable: bool,
+        /// Accessors into the settings.
+        field: Field<S>,
+    },
+}
+
+/// Initial dependencies of an output (ModelStructure `InitialUnknowns`).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Deps {
+    /// Every input and exact parameter (attribute omitted).
+    All,
+    /// Every element of the named rows.
+    Rows(Vec<&'static str>),
+    /// Element `j` of the named row (e.g. `q[j]` on `q0[j]`).
+    SameJoint(&'static str),
+}
+
+/// One quantity of the table (see the module documentation).
+pub struct Row<S> {
+    /// Base name: `q`, `E_ref`, `chart.coef`.
+    pub name: &'static str,
+    /// Expansion per joint.
+    pub shape: Shape,
+    /// Value type.
+    pub kind: Kind,
+    /// Causality and, for parameters, the settings accessors.
+    pub role: Role<S>,
+    /// Unit (Real rows).
+    pub unit: Option<&'static str>,
+    /// Smallest allowed value.
+    pub min: Option<f64>,
+    /// Largest allowed value.
+    pub max: Option<f64>,
+    /// XML description; `{j}` and `{k}` are replaced by the joint (1-based)
+    /// and the power of each element.
+    pub description: String,
+    /// One-line meaning for the Markdown table (default: the description).
+    pub summary: Option<String>,
+    /// Start column of the Markdown table (default: the start values).
+    pub start_text: Option<String>,
+    /// Fixed first value reference of the row's block.
+    pub at: Option<u32>,
+    /// Free tag for selecting rows (e.g. `"model"` for the start-value files).
+    pub group: Option<&'static str>,
+    /// Initial dependencies (outputs).
+    pub initial_dependencies: Deps,
+}
+
+impl<S> Row<S> {
+    fn new(name: &'static str, shape: Shape, kind: Kind) -> Self {
+        Self {
+            name,
+            shape,
+            kind,
+            role: Role::Output {
+                variability: Variability::Continuous,
+            },
+            unit: None,
+            min: None,
+            max: None,
+            description: String::new(),
+            summary: None,
+            start_text: None,
+            at: None,
+            group: None,
+            initial_dependencies: Deps::All,
+        }
+    }
+
+    /// A Real row (an output until a role is chosen).
+    pub fn real(name: &'static str, shape: Shape) -> Self {
+        Self::new(name, shape, Kind::Real)
+    }
+
+    /// An Integer row.
+    pub fn integer(name: &'static str, shape: Shape) -> Self {
+        Self::new(name, shape, Kind::Integer)
+    }
+
+    /// An enumeration row; its range is the items' range.
+    pub fn enumeration(name: &'static str, shape: Shape, t: EnumerationType) -> Self {
+        let min = t.items.iter().map(|i| i.1).min().map(f64::from);
+        let max = t.items.iter().map(|i| i.1).max().map(f64::from);
+        let mut row = Self::new(name, shape, Kind::Enumeration(t));
+        row.min = min;
+        row.max = max;
+        row
+    }
+
+    /// An input with the given start value.
+    pub fn input(mut self, start: f64) -> Self {
+        self.role = Role::Input { start };
+        self
+    }
+
+    /// An output (continuous for Real rows, discrete otherwise).
+    pub fn output(mut self) -> Self {
+        let variability = if self.kind == Kind::Real {
+            Variability::Continuous
+        } else {
+            Variability::Discrete
+        };
+        self.role = Role::Output { variability };
+        self
+    }
+
+    /// A discrete output (changes only at communication points).
+    pub fn discrete_output(mut self) -> Self {
+        self.role = Role::Output {
+            variability: Variability::Discrete,
+        };
+        self
+    }
+
+    /// A fixed parameter.
+    pub fn parameter(mut self, field: Field<S>) -> Self {
+        self.role = Role::Parameter {
+            tunable: false,
+            field,
+        };
+        self
+    }
+
+    /// A tunable parameter.
+    pub fn tunable(mut self, field: Field<S>) -> Self {
+        self.role = Role::Parameter {
+            tunable: true,
+            field,
+        };
+        self
+    }
+
+    /// Sets the unit.
+    pub fn unit(mut self, unit: &'static str) -> Self {
+        self.unit = Some(unit);
+        self
+    }
+
+    /// Sets the allowed range.
+    pub fn range(mut self, min: f64, max: f64) -> Self {
+        self.min = Some(min);
+        self.max = Some(max);
+        self
+    }
+
+    /// Sets the XML description (template with `{j}`, `{k}`).
+    pub fn describe(mut self, text: impl Into<String>) -> Self {
+        self.description = text.into();
+        self
+    }
+
+    /// Sets the Markdown meaning.
+    pub fn summary(mut self, text: impl Into<String>) -> Self {
+        self.summary = Some(text.into());
+        self
+    }
+
+    /// Sets the Markdown start column.
+    pub fn start_text(mut self, text: impl Into<String>) -> Self {
+        self.start_text = Some(text.into());
+        self
+    }
+
+    /// Starts the row's value-reference block at `vr`.
+    pub fn at(mut self, vr: u32) -> Self {
+        self.at = Some(vr);
+        self
+    }
+
+    /// Tags the row.
+    pub fn group(mut self, group: &'static str) -> Self {
+        self.group = Some(group);
+        self
+    }
+
+    /// Sets the initial dependencies (outputs).
+    pub fn initially_depends_on(mut self, deps: Deps) -> Self {
+        self.initial_dependencies = deps;
+        self
+    }
+
+    /// The name of element `e`: `q[2]`, `chart.coef[1,3]`, `E_ref`.
+    pub fn element_name(&self, e: Element) -> String {
+        match self.shape {
+            Shape::Scalar => self.name.to_string(),
+            Shape::Joints => format!("{}[{}]", self.name, e.j + 1),
+            Shape::JointPowers(_) => format!("{}[{},{}]", self.name, e.j + 1, e.k),
+        }
+    }
+
+    /// The name pattern: `q[j]`, `chart.coef[j,k]`, `E_ref`.
+    pub fn pattern(&self) -> String {
+        match self.shape {
+            Shape::Scalar => self.name.to_string(),
+            Shape::Joints => format!("{}[j]", self.name),
+            Shape::JointPowers(_) => format!("{}[j,k]", self.name),
+        }
+    }
+
+    /// True for parameters.
+    pub fn is_parameter(&self) -> bool {
+        matches!(self.role, Role::Parameter { .. })
+    }
+
+    /// True for tunable parameters.
+    pub fn is_tunable(&self) -> bool {
+        matches!(self.role, Role::Parameter { tunable: true, .. })
+    }
+
+    fn start(&self, defaults: &S, e: Element) -> Option<Value> {
+        match &self.role {
+            Role::Input { start } => Some(Value::Real(*start)),
+            Role::Output { .. } => None,
+            Role::Parameter { field, .. } => Some(field.get(defaults, e)),
+        }
+    }
+}
+
+fn fill(template: &str, e: Element) -> String {
+    template
+        .replace("{j}", &(e.j + 1).to_string())
+        .replace("{k}", &e.k.to_string())
+}
+
+/// A table for `n` joints with its value-reference layout.
+pub struct Table<S> {
+    /// Number of joints.
+    pub n: usize,
+    /// The rows, in XML order.
+    pub rows: Vec<Row<S>>,
+    /// First value reference of each row.
+    first: Vec<u32>,
+}
+
+impl<S> Table<S> {
+    /// Lays out the value references: per base type, consecutive in row
+    /// order; a row with [`Row::at`] starts at that reference.
+    pub fn new(n: usize, rows: Vec<Row<S>>) -> Self {
+        let mut next = [0u32; 2];
+        let first = rows
+            .iter()
+            .map(|row| {
+                let slot = match row.kind.base() {
+                    BaseType::Real => 0,
+                    _ => 1,
+                };
+                let start = row.at.unwrap_or(next[slot]);
+                next[slot] = start + row.shape.len(n) as u32;
+                start
+            })
+            .collect();
+        Self { n, rows, first }
+    }
+
+    /// Index of the row named `name`.
+    pub fn row_index(&self, name: &str) -> Option<usize> {
+        self.rows.iter().position(|r| r.name == name)
+    }
+
+    /// The row named `name`.
+    pub fn row(&self, name: &str) -> Option<&Row<S>> {
+        self.row_index(name).map(|i| &self.rows[i])
+    }
+
+    /// Value reference of element `e` of row number `i`.
+    pub fn vr_at(&self, i: usize, e: Element) -> u32 {
+        self.first[i] + self.rows[i].shape.offset(e) as u32
+    }
+
+    /// Value reference of element `e` of the row named `name`.
+    pub fn vr(&self, name: &str, e: Element) -> Option<u32> {
+        self.row_index(name).map(|i| self.vr_at(i, e))
+    }
+
+    /// Value references of the `n` elements of a [`Shape::Joints`] row
+    /// (`None` if there is no such row).
+    pub fn joint_vrs<const N: usize>(&self, name: &str) -> Option<[u32; N]> {
+        let i = self.row_index(name)?;
+        Some(std::array::from_fn(|j| self.vr_at(i, Element { j, k: 0 })))
+    }
+
+    /// The variables (one per element), start values from `defaults`.
+    pub fn variables(&self, defaults: &S) -> Vec<Variable> {
+        let mut out = vec![];
+        for (i, row) in self.rows.iter().enumerate() {
+            for e in row.shape.elements(self.n) {
+                out.push(self.variable(i, row, e, defaults));
+            }
+        }
+        out
+    }
+
+    fn variable(&self, i: usize, row: &Row<S>, e: Element, defaults: &S) -> Variable {
+        let name = row.element_name(e);
+        let vr = self.vr_at(i, e);
+        let mut v = match &row.kind {
+            Kind::Real => Variable::real(name, vr),
+            Kind::Integer => Variable::integer(name, vr),
+            Kind::Enumeration(t) => Variable::enumeration(name, vr, t.name.clone()),
+        };
+        let start = row.start(defaults, e);
+        v = match &row.role {
+            Role::Input { .. } => v.input(start.expect("inputs have a start")),
+            Role::Output { variability } => {
+                let mut v = v.output().variability(*variability).depends_on(&[]);
+                v.initial_dependencies = match &row.initial_dependencies {
+                    Deps::All => None,
+                    Deps::Rows(names) => Some(
+                        names
+                            .iter()
+                            .flat_map(|n| {
+                                let r = self.row(n).unwrap_or_else(|| {
+                                    panic!("{}: unknown dependency row {n}", row.name)
+                                });
+                                r.shape
+                                    .elements(self.n)
+                                    .into_iter()
+                                    .map(|e| r.element_name(e))
+                                    .collect::<Vec<_>>()
+                            })
+                            .collect(),
+                    ),
+                    Deps::SameJoint(n) => {
+                        let r = self
+                            .row(n)
+                            .unwrap_or_else(|| panic!("{}: unknown dependency row {n}", row.name));
+                        Some(vec![r.element_name(e)])
+                    }
+                };
+                v
+            }
+            Role::Parameter { tunable: false, .. } => v.parameter(start.expect("parameter")),
+            Role::Parameter { tunable: true, .. } => v.tunable(start.expect("parameter")),
+        };
+        if let Some(u) = row.unit {
+            v = v.unit(u);
+        }
+        if let Some(m) = row.min {
+            v = v.min(m);
+        }
+        if let Some(m) = row.max {
+            v = v.max(m);
+        }
+        v.describe(fill(&row.description, e))
+    }
+
+    /// The enumeration types the rows use (each once, in row order).
+    pub fn enumerations(&self) -> Vec<EnumerationType> {
+        let mut out: Vec<EnumerationType> = vec![];
+        for row in &self.rows {
+            if let Kind::Enumeration(t) = &row.kind
+                && !out.iter().any(|o| o.name == t.name)
+            {
+                out.push(t.clone());
+            }
+        }
+        out
+    }
+
+    /// Writes the parameters of the rows selected by `select` from the
+    /// FMU's current `values` into `settings`.
+    pub fn read(&self, values: &Values, settings: &mut S, select: impl Fn(&Row<S>) -> bool) {
+        for (i, row) in self.rows.iter().enumerate() {
+            let Role::Parameter { field, .. } = &row.role else {
+                continue;
+            };
+            if !select(row) {
+                continue;
+            }
+            for e in row.shape.elements(self.n) {
+                let vr = self.vr_at(i, e);
+                let v = match row.kind.base() {
+                    BaseType::Real => Value::Real(values.real(vr)),
+                    _ => Value::Integer(values.integer(vr)),
+                };
+                field.set(settings, e, v);
+            }
+        }
+    }
+
+    /// `(name, value)` of every element of the parameter rows selected by
+    /// `select`, read from `settings`, in table order.
+    pub fn start_values(
+        &self,
+        settings: &S,
+        select: impl Fn(&Row<S>) -> bool,
+    ) -> Vec<(String, Value)> {
+        let mut out = vec![];
+        for row in &self.rows {
+            let Role::Parameter { field, .. } = &row.role else {
+                continue;
+            };
+            if select(row) {
+                for e in row.shape.elements(self.n) {
+                    out.push((row.element_name(e), field.get(settings, e)));
+                }
+            }
+        }
+        out
+    }
+
+    /// The C header's constants: `#define <prefix>VR_<NAME><j> <vr>` per
+    /// element (`VR_Q1`, `VR_E_REF`, `VR_Q0_1`), for a joint-power row its
+    /// first reference and an indexing macro `<prefix>VR_<NAME>_JK(j, k)`,
+    /// and `#define <prefix><ROW>_<ITEM> <value>` per enumeration item.
+    pub fn c_defines(&self, prefix: &str, model: &str) -> Result<String, String> {
+        let mut s = String::new();
+        let mut seen = HashSet::new();
+        let mut define = |s: &mut String, name: String, value: String, doc: String| {
+            if !seen.insert(name.clone()) {
+                return Err(format!("{model}: duplicate C constant {name}"));
+            }
+            writeln!(s, "/* {doc} */\n#define {name} {value}").unwrap();
+            Ok(())
+        };
+        writeln!(
+            s,
+            "/* {model}: value references (generated from its variable table). */"
+        )
+        .unwrap();
+        for (i, row) in self.rows.iter().enumerate() {
+            let base = c_identifier(row.name);
+            let family = match row.kind.base() {
+                BaseType::Real => "Real",
+                _ => "Integer",
+            };
+            match row.shape {
+                Shape::JointPowers(powers) => {
+                    let first = self.vr_at(i, Element::default());
+                    define(
+                        &mut s,
+                        format!("{prefix}VR_{base}"),
+                        first.to_string(),
+                        format!(
+                            "{family} value reference of {}",
+                            row.element_name(Element::default())
+                        ),
+                    )?;
+                    define(
+                        &mut s,
+                        format!("{prefix}VR_{base}_JK(j, k)"),
+                        format!("({first} + {powers} * ((j) - 1) + (k))"),
+                        format!(
+                            "{family} value reference of {}[j,k], j = 1..{}, k = 0..{}",
+                            row.name,
+                            self.n,
+                            powers - 1
+                        ),
+                    )?;
+                }
+                _ => {
+                    for e in row.shape.elements(self.n) {
+                        let suffix = match row.shape {
+                            Shape::Scalar => String::new(),
+                            _ if base.ends_with(|c: char| c.is_ascii_digit()) => {
+                                format!("_{}", e.j + 1)
+                            }
+                            _ => (e.j + 1).to_string(),
+                        };
+                        define(
+                            &mut s,
+                            format!("{prefix}VR_{base}{suffix}"),
+                            self.vr_at(i, e).to_string(),
+                            format!("{family} value reference of {}", row.element_name(e)),
+                        )?;
+                    }
+                }
+            }
+            if let Kind::Enumeration(t) = &row.kind {
+                for (item, value, desc) in &t.items {
+                    define(
+                        &mut s,
+                        format!("{prefix}{base}_{}", c_identifier(item)),
+                        value.to_string(),
+                        format!("{}: {desc}", row.name),
+                    )?;
+                }
+            }
+        }
+        Ok(s)
+    }
+
+    /// The rows in documentation form (Markdown tables).
+    pub fn docs(&self, defaults: &S) -> Vec<RowDoc> {
+        self.rows
+            .iter()
+            .enumerate()
+            .map(|(i, row)| {
+                let elements = row.shape.elements(self.n);
+                let integer = row.kind.base() != BaseType::Real;
+                let vrs = match row.shape {
+                    Shape::JointPowers(powers) => format!(
+                        "{}{} + {powers} (j-1) + k",
+                        if integer { "int " } else { "" },
+                        self.first[i]
+                    ),
+                    _ => {
+                        let list: Vec<String> = elements
+                            .iter()
+                            .map(|&e| self.vr_at(i, e).to_string())
+                            .collect();
+                        format!("{}{}", if integer { "int " } else { "" }, list.join(", "))
+                    }
+                };
+                let causality = match (&row.role, &row.kind) {
+                    (Role::Input { .. }, _) => "input".to_string(),
+                    (
+                        Role::Output {
+                            variability: Variability::Discrete,
+                        },
+                        Kind::Real,
+                    ) => "output (discrete)".to_string(),
+                    (Role::Output { .. }, _) => "output".to_string(),
+                    (Role::Parameter { tunable, .. }, kind) => format!(
+                        "parameter ({}){}",
+                        if *tunable { "**tunable**" } else { "fixed" },
+                        if matches!(kind, Kind::Enumeration(_)) {
+                            ", enumeration"
+                        } else {
+                            ""
+                        }
+                    ),
+                };
+                let start = row.start_text.clone().unwrap_or_else(|| {
+                    let values: Vec<String> = elements
+                        .iter()
+                        .filter_map(|&e| row.start(defaults, e))
+                        .map(|v| match (&row.kind, v) {
+                            (Kind::Enumeration(t), Value::Integer(i)) => t
+                                .items
+                                .iter()
+                                .find(|it| it.1 == i)
+                                .map(|it| format!("{} ({i})", it.0))
+                                .unwrap_or_else(|| i.to_string()),
+                            (_, v) => value_text(v),
+                        })
+                        .collect();
+                    if values.iter().all(|v| Some(v) == values.first()) {
+                        values.first().cloned().unwrap_or_default()
+                    } else {
+                        values.join(", ")
+                    }
+                });
+                let range = match (&row.kind, row.min, row.max) {
+                    (Kind::Enumeration(t), _, _) => t
+                        .items
+                        .iter()
+                        .map(|(name, v, _)| format!("{name} ({v})"))
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                    (_, Some(a), Some(b)) => format!("[{}, {}]", compact(a), compact(b)),
+                    (_, Some(a), None) => format!(">= {}", compact(a)),
+                    (_, None, Some(b)) => format!("<= {}", compact(b)),
+                    (Kind::Real, None, None) if !matches!(row.role, Role::Output { .. }) => {
+                        "finite".into()
+                    }
+                    _ => String::new(),
+                };
+                let meaning = row
+                    .summary
+                    .clone()
+                    .unwrap_or_else(|| row.description.replace("{j}", "j").replace("{k}", "k"));
+                RowDoc {
+                    name: row.pattern(),
+                    vrs,
+                    causality,
+                    unit: row.unit.unwrap_or("").to_string(),
+                    start,
+                    range,
+                    meaning,
+                }
+            })
+            .collect()
+    }
+}
+
+/// One row of a Markdown variable table.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RowDoc {
+    /// Name pattern (`q[j]`).
+    pub name: String,
+    /// Value references.
+    pub vrs: String,
+    /// Causality and variability.
+    pub causality: String,
+    /// Unit.
+    pub unit: String,
+    /// Start value(s).
+    pub start: String,
+    /// Allowed range.
+    pub range: String,
+    /// Meaning.
+    pub meaning: String,
+}
+
+/// A Markdown table of several FMUs with the same rows (one value-reference
+/// column per FMU; the other columns from the first).
+pub fn markdown(fmus: &[(&str, Vec<RowDoc>)]) -> Result<String, String> {
+    let Some((_, first)) = fmus.first() else {
+        return Ok(String::new());
+    };
+    for (name, docs) in fmus {
+        let names: Vec<&String> = docs.iter().map(|d| &d.name).collect();
+        let expected: Vec<&String> = first.iter().map(|d| &d.name).collect();
+        if names != expected {
+            return Err(format!("{name}: rows differ from {}", fmus[0].0));
+        }
+        for (d, f) in docs.iter().zip(first) {
+            let same = (&d.causality, &d.unit, &d.start, &d.range, &d.meaning)
+                == (&f.causality, &f.unit, &f.start, &f.range, &f.meaning);
+            if !same {
+                return Err(format!(
+                    "{}: row {} differs from {}'s in more than its value references \
+                     ({d:?} vs {f:?}); give it a start text or summary that fits both",
+                    name, d.name, fmus[0].0
+                ));
+            }
+        }
+    }
+    let mut s = String::from("| name |");
+    for (name, _) in fmus {
+        write!(s, " vr `{name}` |").unwrap();
+    }
+    s.push_str(" causality | unit | start | range | meaning |\n|");
+    for _ in 0..fmus.len() + 6 {
+        s.push_str(" --- |");
+    }
+    s.push('\n');
+    let cell = |t: &str| t.replace('|', "\\|");
+    for (i, d) in first.iter().enumerate() {
+        write!(s, "| `{}` |", d.name).unwrap();
+        for (_, docs) in fmus {
+            write!(s, " {} |", docs[i].vrs).unwrap();
+        }
+        writeln!(
+            s,
+            " {} | {} | {} | {} | {} |",
+            d.causality,
+            cell(&d.unit),
+            cell(&d.start),
+            cell(&d.range),
+            cell(&d.meaning)
+        )
+        .unwrap();
+    }
+    Ok(s)
+}
+
+/// `E_ref` -> `E_REF`, `chart.coef` -> `CHART_COEF`.
+fn c_identifier(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() {
+                c.to_ascii_uppercase()
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
+
+fn value_text(v: Value) -> String {
+    match v {
+        Value::Real(x) => compact(x),
+        Value::Integer(i) => i.to_string(),
+        Value::Boolean(b) => b.to_string(),
+    }
+}
+
+/// The shorter of Rust's shortest round-trip decimal and exponent forms:
+/// `1e-6`, `9.81`, `2500`, `1e6`.
+pub fn compact(x: f64) -> String {
+    let plain = format!("{x}");
+    let exp = format!("{x:e}");
+    if exp.len() < plain.len() { exp } else { plain }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[derive(Default)]
+    struct S {
+        a: [f64; 3],
+        c: [[f64; 2]; 3],
+        mode: i32,
+    }
+
+    fn table(n: usize) -> Table<S> {
+        Table::new(
+            n,
+            vec![
+                Row::<S>::real("q", Shape::Joints).input(0.0).unit("rad"),
+                Row::<S>::real("energy", Shape::Scalar).output(),
+                Row::<S>::real("a", Shape::Joints)
+                    .parameter(Field::real(|s, e| s.a[e.j], |s, e, v| s.a[e.j] = v))
+                    .range(0.0, 1e6)
+                    .describe("a of joint {j}"),
+                Row::<S>::real("c.x", Shape::JointPowers(2))
+                    .parameter(Field::real(
+                        |s, e| s.c[e.j][e.k],
+                        |s, e, v| s.c[e.j][e.k] = v,
+                    ))
+                    .at(100),
+                Row::<S>::real("q0", Shape::Joints)
+                    .parameter(Field::real(|_, _| 0.5, |_, _, _| {})),
+                Row::<S>::integer("mode", Shape::Scalar)
+                    .parameter(Field::integer(|s, _| s.mode, |s, _, v| s.mode = v)),
+            ],
+        )
+    }
+
+    #[test]
+    fn layout_is_consecutive_per_base_type_with_fixed_blocks() {
+        let t = table(3);
+        assert_eq!(t.joint_vrs::<3>("q"), Some([0, 1, 2]));
+        assert_eq!(t.vr("energy", Element::default()), Some(3));
+        assert_eq!(t.joint_vrs::<3>("a"), Some([4, 5, 6]));
+        assert_eq!(t.vr("c.x", Element { j: 2, k: 1 }), Some(105));
+        assert_eq!(t.joint_vrs::<3>("q0"), Some([106, 107, 108]));
+        assert_eq!(t.vr("mode", Element::default()), Some(0));
+        let t2 = table(2);
+        assert_eq!(t2.joint_vrs::<2>("a"), Some([3, 4]));
+        assert_eq!(t2.vr("c.x", Element { j: 1, k: 1 }), Some(103));
+    }
+
+    #[test]
+    fn variables_names_and_start_values_follow_the_rows() {
+        let t = table(2);
+        let s = S {
+            a: [1.5, 2.5, 0.0],
+            ..Default::default()
+        };
+        let v = t.variables(&s);
+        let names: Vec<&str> = v.iter().map(|v| v.name.as_str()).collect();
+        assert_eq!(
+            names,
+            [
+                "q[1]", "q[2]", "energy", "a[1]", "a[2]", "c.x[1,0]", "c.x[1,1]", "c.x[2,0]",
+                "c.x[2,1]", "q0[1]", "q0[2]", "mode"
+            ]
+        );
+        assert_eq!(v[4].start, Some(Value::Real(2.5)));
+        assert_eq!(v[4].description, "a of joint 2");
+        assert_eq!(v[4].max, Some(1e6));
+        let sv = t.start_values(&s, |r| r.name == "a");
+        assert_eq!(
+            sv,
+            [
+                ("a[1]".to_string(), Value::Real(1.5)),
+                ("a[2]".to_string(), Value::Real(2.5))
+            ]
+        );
+    }
+
+    #[test]
+    fn c_defines_and_markdown() {
+        let t = table(2);
+        let h = t.c_defines("X_", "X").unwrap();
+        assert!(h.contains("#define X_VR_Q1 0\n"), "{h}");
+        assert!(h.contains("#define X_VR_Q0_2 105\n"), "{h}");
+        assert!(h.contains("#define X_VR_C_X_JK(j, k) (100 + 2 * ((j) - 1) + (k))"));
+        assert!(h.contains("#define X_VR_MODE 0\n"));
+        let md = markdown(&[("X", t.docs(&S::default()))]).unwrap();
+        assert!(
+            md.contains("| `a[j]` | 3, 4 | parameter (fixed) |  | 0 | [0, 1e6] | a of joint j |"),
+            "{md}"
+        );
+        assert!(md.contains("| `c.x[j,k]` | 100 + 2 (j-1) + k |"), "{md}");
+        assert_eq!(compact(1e-6), "1e-6");
+        assert_eq!(compact(9.81), "9.81");
+        assert_eq!(compact(2500.0), "2500");
+    }
+}

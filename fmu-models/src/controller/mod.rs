@@ -1,0 +1,228 @@
+//! The EigenMPC controller (paper, section IV; `eigenmpc::mpc::Controller`)
+//! for an `N`-joint planar chain as an FMI 2.0 Co-Simulation model.
+//!
+//! - [`table`]: the variable table (value references, start values, ...);
+//! - [`settings`]: the controller definition the table fills in;
+//! - [`timing`]: the sample grid (when to solve);
+//! - [`docs`]: the documentation page's introduction;
+//! - [`start_values`]: the start values of a given robot and reference.
+//!
+//! Timing: the controller solves at the communication points that fall on
+//! its sample grid `t_start + k * sample_period` (or, when a grid point falls
+//! inside a communication step, at the first communication point after it).
+//! A solve at `t` uses the inputs set for `t` (before `fmi2DoStep(t, h)`, or
+//! in initialization mode for `t_start`); its torque is the output once that
+//! call returns (`fmi2ExitInitializationMode` for the first solve) and is
+//! held until the next solve.
+
+pub mod docs;
+pub mod settings;
+pub mod start_values;
+pub mod table;
+pub mod timing;
+
+use crate::units;
+use eigenmpc::mpc::{ControlOutput, MpcConfig, Variant};
+use fmi2_slave::table::{Element, Table};
+use fmi2_slave::{Context, DefaultExperiment, Model, ModelDescription, ModelError, Values};
+use nalgebra::SVector;
+use settings::{CHART_COEFFICIENTS, ChainController, Settings};
+use std::marker::PhantomData;
+use timing::{SampleClock, Tick};
+
+/// One controller FMU product: its name and default reference (the
+/// in-phase eigenmode of the default model at `E_REF`).
+pub trait ControllerProduct<const N: usize>: 'static {
+    /// `modelName` and `modelIdentifier`.
+    const MODEL_NAME: &'static str;
+    /// One-line description.
+    const DESCRIPTION: &'static str;
+    /// Default `E_ref` (J): the energy of the default chart.
+    const E_REF: f64;
+    /// Default eigenvector: the in-phase linear mode of the default model.
+    const EIGENVECTOR: [f64; N];
+    /// Default chart: the in-phase eigenmode of the default model at `E_REF`.
+    const CHART: [[f64; CHART_COEFFICIENTS]; N];
+
+    /// The paper's settings for `variant` with the default reference.
+    fn settings(variant: Variant) -> Settings<N> {
+        Settings::paper(variant, Self::E_REF, Self::EIGENVECTOR, Self::CHART)
+    }
+}
+
+/// Value references the sample path reads and writes.
+#[derive(Clone, Copy, Debug)]
+struct Io<const N: usize> {
+    q: [u32; N],
+    qd: [u32; N],
+    tau: [u32; N],
+    energy: u32,
+    solve_time: u32,
+    qp_iterations: u32,
+    solver_status: u32,
+}
+
+impl<const N: usize> Io<N> {
+    fn new(t: &Table<Settings<N>>) -> Result<Self, String> {
+        let joints = |name| {
+            t.joint_vrs::<N>(name)
+                .ok_or_else(|| format!("no row {name}"))
+        };
+        let scalar = |name| {
+            t.vr(name, Element::default())
+                .ok_or_else(|| format!("no row {name}"))
+        };
+        Ok(Self {
+            q: joints("q")?,
+            qd: joints("qd")?,
+            tau: joints("tau")?,
+            energy: scalar("energy")?,
+            solve_time: scalar("solve_time")?,
+            qp_iterations: scalar("qp_iterations")?,
+            solver_status: scalar("solver_status")?,
+        })
+    }
+}
+
+/// The EigenMPC controller FMU model for `N` joints (`NX = 2 N`).
+pub struct ControllerFmu<P, const N: usize, const NX: usize> {
+    controller: ChainController<N, NX>,
+    settings: Settings<N>,
+    table: Table<Settings<N>>,
+    io: Io<N>,
+    clock: SampleClock,
+    /// State of the last solve (a changed state at `t_start` re-solves).
+    solved_state: SVector<f64, NX>,
+    product: PhantomData<fn() -> P>,
+}
+
+/// The model description of product `P`.
+pub fn description<P: ControllerProduct<N>, const N: usize>() -> ModelDescription {
+    let t = table::table::<N>();
+    let variables = t.variables(&P::settings(Variant::Curved));
+    ModelDescription {
+        model_name: P::MODEL_NAME.into(),
+        model_identifier: P::MODEL_NAME.into(),
+        description: P::DESCRIPTION.into(),
+        version: env!("CARGO_PKG_VERSION").into(),
+        author: "EigenMPC project".into(),
+        generation_tool: format!("fmi2-slave (EigenMPC) {}", env!("CARGO_PKG_VERSION")),
+        can_handle_variable_communication_step_size: true,
+        default_experiment: Some(DefaultExperiment {
+            start_time: 0.0,
+            stop_time: 30.0,
+            step_size: MpcConfig::paper(Variant::Curved).dt,
+        }),
+        units: units::used_by(&variables),
+        enumerations: t.enumerations(),
+        variables,
+    }
+}
+
+impl<P: ControllerProduct<N> + Send, const N: usize, const NX: usize> Model
+    for ControllerFmu<P, N, NX>
+{
+    fn description() -> ModelDescription {
+        description::<P, N>()
+    }
+
+    fn initialize(values: &mut Values, ctx: &Context) -> Result<Self, ModelError> {
+        let table = table::table::<N>();
+        let io = Io::new(&table).map_err(ModelError::Error)?;
+        let mut settings = P::settings(Variant::Curved);
+        table.read(values, &mut settings, |_| true);
+        let controller = settings.build::<NX>().map_err(ModelError::Error)?;
+        let mut model = Self {
+            controller,
+            clock: SampleClock::new(ctx.experiment.start_time, settings.sample_period),
+            settings,
+            table,
+            io,
+            solved_state: SVector::zeros(),
+            product: PhantomData,
+        };
+        model.solve(values, ctx.experiment.start_time, ctx);
+        Ok(model)
+    }
+
+    fn do_step(
+        &mut self,
+        values: &mut Values,
+        t: f64,
+        h: f64,
+        ctx: &Context,
+    ) -> Result<(), ModelError> {
+        match self.clock.step(t, h, ctx.log) {
+            Tick::Solve => self.solve(values, t, ctx),
+            Tick::AtStart if self.inputs(values) != self.solved_state => {
+                // New inputs for t_start after initialization: solve t_start again.
+                self.controller.reset();
+                self.solve(values, t, ctx);
+            }
+            Tick::AtStart | Tick::Hold => {}
+        }
+        Ok(())
+    }
+
+    fn update_tunables(&mut self, values: &mut Values, _ctx: &Context) -> Result<(), ModelError> {
+        let mut settings = self.settings.clone();
+        self.table.read(values, &mut settings, |r| r.is_tunable());
+        self.controller
+            .set_cost(settings.tuning.cost(settings.variant))
+            .map_err(|e| ModelError::Error(e.to_string()))?;
+        self.settings = settings;
+        Ok(())
+    }
+}
+
+impl<P, const N: usize, const NX: usize> ControllerFmu<P, N, NX> {
+    fn inputs(&self, values: &Values) -> SVector<f64, NX> {
+        SVector::from_fn(|i, _| {
+            if i < N {
+                values.real(self.io.q[i])
+            } else {
+                values.real(self.io.qd[i - N])
+            }
+        })
+    }
+
+    /// One controller sample with the current inputs; writes the outputs.
+    fn solve(&mut self, values: &mut Values, t: f64, ctx: &Context) {
+        let z = self.inputs(values);
+        let out = self.controller.step(&z);
+        self.solved_state = z;
+        if !out.status.is_ok() {
+            // Failure path only: the message allocates.
+            ctx.log.warning(&format!(
+                "t = {t} s: {}; tau = {:?} N.m",
+                out.status,
+                out.tau.as_slice()
+            ));
+        }
+        let energy = self.controller.energy(&z);
+        self.write_outputs(values, &out, energy);
+    }
+
+    fn write_outputs(&self, values: &mut Values, out: &ControlOutput<N>, energy: f64) {
+        for j in 0..N {
+            values.set_real(self.io.tau[j], out.tau[j]);
+        }
+        values.set_real(self.io.energy, energy);
+        values.set_real(self.io.solve_time, out.preparation_time + out.feedback_time);
+        values.set_integer(
+            self.io.qp_iterations,
+            i32::try_from(out.qp_iterations).unwrap_or(i32::MAX),
+        );
+        values.set_integer(self.io.solver_status, out.status.code());
+    }
+
+    /// The controller (diagnostics and tests).
+    pub fn controller(&self) -> &ChainController<N, NX> {
+        &self.controller
+    }
+
+    /// The settings the controller was built from (tunables: the latest).
+    pub fn settings(&self) -> &Settings<N> {
+        &self.settings
+    }
+}

@@ -1,0 +1,194 @@
+//! Everything that defines one controller, shared by the FMU (filled from
+//! its parameters through the variable table) and the plain C API (filled
+//! from its config struct), so both build the controller the same way.
+
+use crate::chain::{ChainParameters, HasChain};
+use eigenmpc::mechanics::{MechanicalSystem, PlanarChain, Vector};
+use eigenmpc::modes::Chart;
+use eigenmpc::mpc::{Controller, CostParams, MpcConfig, QpBackend, Reference, Variant, Weights};
+
+/// Number of chart coefficients per joint (powers `0..=9`, the paper's degree).
+pub const CHART_COEFFICIENTS: usize = 10;
+
+/// The controller behind an `N`-joint FMU (`NX = 2 N`).
+pub type ChainController<const N: usize, const NX: usize> = Controller<PlanarChain<N>, N, NX>;
+
+/// The energy weight actually used: a negative `w_E` selects the paper's
+/// value for the variant (25 curved, 5 straight).
+pub fn effective_energy_weight(w_e: f64, variant: Variant) -> f64 {
+    if w_e < 0.0 {
+        Weights::paper(variant).energy
+    } else {
+        w_e
+    }
+}
+
+/// Tunable cost parameters as the FMU and C API take them (`w_E < 0`: paper default).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tuning {
+    /// Reference energy `E_ref` (J).
+    pub e_ref: f64,
+    /// Exploration gain `alpha` (1/J).
+    pub alpha: f64,
+    /// Torque-weight offset `beta`.
+    pub beta: f64,
+    /// Energy weight `w_E` (negative: paper default of the variant).
+    pub w_e: f64,
+    /// Position weight `w_x`.
+    pub w_x: f64,
+    /// Velocity weight `w_xd`.
+    pub w_xd: f64,
+    /// Torque weight `w_F`.
+    pub w_f: f64,
+}
+
+impl Tuning {
+    /// The paper's tuning with `w_E` left to the variant's default.
+    pub fn paper() -> Self {
+        let p = MpcConfig::paper(Variant::Curved).cost;
+        Self {
+            e_ref: p.e_ref,
+            alpha: p.alpha,
+            beta: p.beta,
+            w_e: -1.0,
+            w_x: p.weights.position,
+            w_xd: p.weights.velocity,
+            w_f: p.weights.torque,
+        }
+    }
+
+    /// The controller's cost parameters for `variant` (what is not exposed:
+    /// the library's paper defaults).
+    pub fn cost(&self, variant: Variant) -> CostParams {
+        CostParams {
+            e_ref: self.e_ref,
+            alpha: self.alpha,
+            beta: self.beta,
+            weights: Weights {
+                energy: effective_energy_weight(self.w_e, variant),
+                position: self.w_x,
+                velocity: self.w_xd,
+                torque: self.w_f,
+            },
+            ..MpcConfig::paper(variant).cost
+        }
+    }
+}
+
+/// One controller's full definition.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Settings<const N: usize> {
+    /// Straight or curved EigenMPC.
+    pub variant: Variant,
+    /// QP solver of the real-time iteration.
+    pub qp: QpBackend,
+    /// Tunable cost parameters.
+    pub tuning: Tuning,
+    /// Torque bound `|tau_i| <= tau_max` (N m).
+    pub tau_max: f64,
+    /// Shooting intervals `N`.
+    pub horizon: usize,
+    /// Sample period and shooting interval `dt` (s).
+    pub sample_period: f64,
+    /// The controller's model.
+    pub model: ChainParameters<N>,
+    /// Linear eigenvector `c` (normalised when the controller is built).
+    pub eigenvector: [f64; N],
+    /// Chart coefficients (curved): joint, power.
+    pub chart: [[f64; CHART_COEFFICIENTS]; N],
+}
+
+impl<const N: usize> HasChain<N> for Settings<N> {
+    fn chain(&self) -> &ChainParameters<N> {
+        &self.model
+    }
+    fn chain_mut(&mut self) -> &mut ChainParameters<N> {
+        &mut self.model
+    }
+}
+
+impl<const N: usize> Settings<N> {
+    /// The paper's setting for `variant` on the default model, with the
+    /// given reference (energy, eigenvector, chart).
+    pub fn paper(
+        variant: Variant,
+        e_ref: f64,
+        eigenvector: [f64; N],
+        chart: [[f64; CHART_COEFFICIENTS]; N],
+    ) -> Self {
+        let config = MpcConfig::paper(variant);
+        Self {
+            variant,
+            qp: config.qp,
+            tuning: Tuning {
+                e_ref,
+                ..Tuning::paper()
+            },
+            tau_max: config.tau_max,
+            horizon: config.horizon,
+            sample_period: config.dt,
+            model: ChainParameters::default(),
+            eigenvector,
+            chart,
+        }
+    }
+
+    /// The controller configuration (paper defaults for what is not exposed).
+    pub fn config(&self) -> MpcConfig {
+        let mut config = MpcConfig::paper(self.variant);
+        config.horizon = self.horizon;
+        config.dt = self.sample_period;
+        config.tau_max = self.tau_max;
+        config.cost = self.tuning.cost(self.variant);
+        config.qp = self.qp;
+        config
+    }
+
+    /// The controller's model; the message names the FMU parameter.
+    pub fn system(&self) -> Result<PlanarChain<N>, String> {
+        self.model.build()
+    }
+
+    /// The reference of the variant on `system`: the eigenvector line
+    /// (straight) or the chart (curved), checked to belong together.
+    pub fn reference(&self, system: &PlanarChain<N>) -> Result<Reference<N>, String> {
+        let c = Vector::<N>::from(self.eigenvector);
+        if !c.iter().all(|v| v.is_finite()) || c.norm() < 1e-6 {
+            let list: Vec<String> = c.iter().map(|x| x.to_string()).collect();
+            return Err(format!(
+                "eigenvector c = ({}) must be finite and nonzero",
+                list.join(", ")
+            ));
+        }
+        let c = c.normalize();
+        match self.variant {
+            Variant::Straight => Ok(Reference::Straight { eigenvector: c }),
+            Variant::Curved => {
+                let chart = Chart::from_coefficients(
+                    c,
+                    system.equilibrium(),
+                    self.chart.map(|row| row.to_vec()),
+                )
+                .map_err(|e| format!("invalid chart: {e}"))?;
+                // A chart fitted in s = c'q has c'X'(0) = 1 along its path; a
+                // chart of another mode (or another c) does not, and s would
+                // then silently mean something else.
+                let slope = c.dot(&chart.eval(0.0).dx);
+                if !(0.8..=1.25).contains(&slope) {
+                    return Err(format!(
+                        "chart and eigenvector c do not belong together: c'X'(0) = {slope:.3} \
+                         (a chart fitted in s = c'q has 1); pass the c[j] written with the chart"
+                    ));
+                }
+                Ok(Reference::Curved(chart))
+            }
+        }
+    }
+
+    /// Builds the controller (`NX = 2 N`); the message names what is wrong.
+    pub fn build<const NX: usize>(&self) -> Result<ChainController<N, NX>, String> {
+        let system = self.system()?;
+        let reference = self.reference(&system)?;
+        Controller::new(system, self.config(), reference).map_err(|e| e.to_string())
+    }
+}

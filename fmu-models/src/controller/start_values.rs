@@ -1,0 +1,61 @@
+//! The controller FMU's start values for a given robot and reference, from
+//! the same table as the FMU (what `eigenmpc modes --fmu-start-values`
+//! writes).
+
+use super::settings::{CHART_COEFFICIENTS, Settings};
+use super::table::{REFERENCE_GROUP, table};
+use crate::chain::{ChainParameters, MODEL_GROUP};
+use eigenmpc::mechanics::PlanarChainParams;
+use eigenmpc::mpc::Variant;
+use fmi2_slave::Value;
+
+/// The start values (name, value), in table order, that make the `N`-joint
+/// controller FMU control `model` at `e_ref` along the chart
+/// `X_j(s) = sum_k chart[j][k] s^k` in `s = c'q` with the unit eigenvector
+/// `eigenvector`: `E_ref`, every model parameter (`m[j]`, `l[j]`, `g`,
+/// `r[j]`, `I[j]`, `Ir[j]`, ...), `c[j]` and `chart.coef[j,k]` (zero-padded
+/// to 10 powers).
+///
+/// Refused (the message names the variable): a model the FMU cannot
+/// express or that is not physical, more than 10 coefficients per joint,
+/// a value outside its variable's range, a chart that does not belong to
+/// the eigenvector.
+pub fn start_values<const N: usize>(
+    model: &PlanarChainParams<N>,
+    e_ref: f64,
+    eigenvector: &[f64; N],
+    chart: &[Vec<f64>; N],
+) -> Result<Vec<(String, Value)>, String> {
+    let mut settings = Settings::<N>::paper(
+        Variant::Curved,
+        e_ref,
+        *eigenvector,
+        [[0.0; CHART_COEFFICIENTS]; N],
+    );
+    settings.model = ChainParameters::from_params(model)?;
+    for (j, row) in chart.iter().enumerate() {
+        if row.len() > CHART_COEFFICIENTS {
+            return Err(format!(
+                "the chart of joint {} has {} coefficients; the FMU takes at most {} (degree {})",
+                j + 1,
+                row.len(),
+                CHART_COEFFICIENTS,
+                CHART_COEFFICIENTS - 1
+            ));
+        }
+        settings.chart[j][..row.len()].copy_from_slice(row);
+    }
+    let system = settings.system()?;
+    settings.reference(&system)?;
+    let t = table::<N>();
+    let values = t.start_values(&settings, |r| {
+        matches!(r.group, Some(MODEL_GROUP) | Some(REFERENCE_GROUP))
+    });
+    let variables = t.variables(&settings);
+    for (name, value) in &values {
+        if let Some(v) = variables.iter().find(|v| &v.name == name) {
+            v.check_value(*value)?;
+        }
+    }
+    Ok(values)
+}

@@ -1,0 +1,227 @@
+//! The controller FMU's variable table for `N` joints: the single source of
+//! its variables, value references, start values, XML, documentation,
+//! README table, C constants and start-value files.
+//!
+//! Value references are laid out by [`fmi2_slave::table::Table::new`]: per
+//! base type consecutive in row order, the chart block at 100. For two
+//! joints this is the layout of the original `EigenMPC.fmu` (pinned by a
+//! test). **Add new rows at the end** (after `qp_solver` and the chain rows)
+//! so that existing value references stay; a row is its name, shape, type,
+//! role with two accessors into [`Settings`], unit, range and description:
+//!
+//! ```ignore
+//! Rw::<N>::enumeration("chart_source", Scalar, CHART_SOURCE.fmi_type())
+//!     .parameter(Field::integer(
+//!         |s, _| CHART_SOURCE.item(s.chart_source),
+//!         |s, _, v| s.chart_source = CHART_SOURCE.value(v).unwrap_or_default(),
+//!     ))
+//!     .describe("Where the curved chart comes from"),
+//! ```
+
+use super::settings::{CHART_COEFFICIENTS, Settings};
+use crate::chain::{point_mass_rows, rigid_rows};
+use crate::enums::{QP_SOLVER, VARIANT};
+use fmi2_slave::table::{Deps, Field, Row, Shape, Table};
+
+/// Group tag of the reference rows (`E_ref`, `c[j]`, `chart.coef[j,k]`),
+/// written to start-value files with the model rows.
+pub const REFERENCE_GROUP: &str = "reference";
+
+/// First value reference of the chart block.
+pub const CHART_VR: u32 = 100;
+
+type Rw<const N: usize> = Row<Settings<N>>;
+
+/// A tunable Real parameter of the tuning.
+fn tunable<const N: usize>(
+    name: &'static str,
+    get: fn(&Settings<N>, fmi2_slave::table::Element) -> f64,
+    set: fn(&mut Settings<N>, fmi2_slave::table::Element, f64),
+    (min, max): (f64, f64),
+    what: &str,
+) -> Rw<N> {
+    Rw::<N>::real(name, Shape::Scalar)
+        .tunable(Field::real(get, set))
+        .range(min, max)
+        .describe(format!("{what}; tunable between steps"))
+        .summary(what)
+}
+
+/// The variable table of the `N`-joint controller.
+pub fn table<const N: usize>() -> Table<Settings<N>> {
+    let mut rows = vec![
+        Rw::<N>::real("q", Shape::Joints)
+            .input(0.0)
+            .unit("rad")
+            .describe(
+                "Measured angle of joint {j} (q[1] from the downward vertical, q[j] of link j \
+                 relative to link j-1); a solve uses the value set for its communication point",
+            )
+            .summary("measured joint angles (as the plant's outputs)"),
+        Rw::<N>::real("qd", Shape::Joints)
+            .input(0.0)
+            .unit("rad/s")
+            .describe(
+                "Measured speed of joint {j}; a solve uses the value set for its communication \
+                 point",
+            )
+            .summary("measured joint speeds"),
+        Rw::<N>::real("tau", Shape::Joints)
+            .discrete_output()
+            .unit("N.m")
+            .describe("Torque at joint {j} from the last solve, held until the next one")
+            .summary("torque of the last solve (within tau_max), held until the next"),
+        Rw::<N>::real("energy", Shape::Scalar)
+            .discrete_output()
+            .unit("J")
+            .describe("Energy of the state the last solve used (controller's model)")
+            .summary("energy of the state the last solve used")
+            .initially_depends_on(Deps::Rows(vec![
+                "q", "qd", "m", "l", "g", "r", "I", "Ir", "gr", "k", "q_rest",
+            ])),
+        Rw::<N>::real("solve_time", Shape::Scalar)
+            .discrete_output()
+            .unit("s")
+            .describe("Wall-clock time of the last solve (preparation + feedback)")
+            .summary("wall time of the last solve"),
+        Rw::<N>::integer("qp_iterations", Shape::Scalar)
+            .output()
+            .describe("Interior-point iterations of the last solve's QP(s)"),
+        Rw::<N>::integer("solver_status", Shape::Scalar)
+            .output()
+            .describe(
+                "Status of the last solve: 0 solved; 1 first-sample SQP not converged \
+                 (torque from the last iterate); 2 QP failed (torque = fallback: previous \
+                 plan's next control, clipped). 3 (invalid state) only occurs through the \
+                 C API: the FMU refuses NaN/Inf inputs with fmi2Error",
+            )
+            .summary(
+                "0 solved; 1 first-sample SQP not converged; 2 QP failed (fallback torque = \
+                 previous plan's next control, clipped, and a logged warning); 3 invalid state \
+                 occurs only through the C API: the FMU refuses NaN/Inf inputs with fmi2Error",
+            ),
+        Rw::<N>::enumeration(VARIANT.parameter, Shape::Scalar, VARIANT.fmi_type())
+            .parameter(Field::integer(
+                |s, _| VARIANT.item(s.variant),
+                |s, _, v| s.variant = VARIANT.value(v).unwrap_or(s.variant),
+            ))
+            .describe("EigenMPC cost: straight (eigenvector line) or curved (eigenmode chart)"),
+        tunable(
+            "E_ref",
+            |s, _| s.tuning.e_ref,
+            |s, _, v| s.tuning.e_ref = v,
+            (0.0, 1e4),
+            "reference energy",
+        )
+        .unit("J")
+        .group(REFERENCE_GROUP),
+        tunable(
+            "alpha",
+            |s, _| s.tuning.alpha,
+            |s, _, v| s.tuning.alpha = v,
+            (0.0, 1e3),
+            "exploration gain of the straight cost (blend tanh(alpha E))",
+        )
+        .unit("1/J"),
+        tunable(
+            "beta",
+            |s, _| s.tuning.beta,
+            |s, _, v| s.tuning.beta = v,
+            (0.0, 1e3),
+            "torque-weight offset of the straight cost",
+        ),
+        tunable(
+            "w_E",
+            |s, _| s.tuning.w_e,
+            |s, _, v| s.tuning.w_e = v,
+            (-1.0, 1e8),
+            "energy weight; **negative = the paper's value of the variant: 25 curved, 5 straight**",
+        ),
+        tunable(
+            "w_x",
+            |s, _| s.tuning.w_x,
+            |s, _, v| s.tuning.w_x = v,
+            (0.0, 1e8),
+            "position-distance weight",
+        ),
+        tunable(
+            "w_xd",
+            |s, _| s.tuning.w_xd,
+            |s, _, v| s.tuning.w_xd = v,
+            (0.0, 1e8),
+            "velocity-distance weight",
+        ),
+        tunable(
+            "w_F",
+            |s, _| s.tuning.w_f,
+            |s, _, v| s.tuning.w_f = v,
+            (1e-9, 1e8),
+            "torque weight (> 0)",
+        ),
+        Rw::<N>::real("tau_max", Shape::Scalar)
+            .parameter(Field::real(|s, _| s.tau_max, |s, _, v| s.tau_max = v))
+            .unit("N.m")
+            .range(1e-6, 1e6)
+            .describe("Torque bound |tau[j]| <= tau_max"),
+        Rw::<N>::integer("horizon", Shape::Scalar)
+            .parameter(Field::integer(
+                |s, _| s.horizon as i32,
+                |s, _, v| s.horizon = v.max(0) as usize,
+            ))
+            .range(1.0, eigenmpc::mpc::MAX_HORIZON as f64)
+            .describe("Shooting intervals N of the prediction horizon"),
+        Rw::<N>::real("sample_period", Shape::Scalar)
+            .parameter(Field::real(
+                |s, _| s.sample_period,
+                |s, _, v| s.sample_period = v,
+            ))
+            .unit("s")
+            .range(1e-4, 10.0)
+            .describe("Sample period and shooting interval dt"),
+    ];
+    rows.extend(point_mass_rows::<Settings<N>, N>("Controller model: "));
+    rows.extend([
+        Rw::<N>::real("c", Shape::Joints)
+            .parameter(Field::real(
+                |s, e| s.eigenvector[e.j],
+                |s, e, v| s.eigenvector[e.j] = v,
+            ))
+            .range(-1.0, 1.0)
+            .describe(
+                "Linear eigenvector c, component {j} (normalised; default: in-phase mode of the \
+                 default model); chart coordinate s = c'q",
+            )
+            .summary("linear eigenvector (normalised, nonzero); chart coordinate s = c'q")
+            .start_text("in-phase mode of the default model")
+            .group(REFERENCE_GROUP),
+        Rw::<N>::real("chart.coef", Shape::JointPowers(CHART_COEFFICIENTS))
+            .parameter(Field::real(
+                |s, e| s.chart[e.j][e.k],
+                |s, e, v| s.chart[e.j][e.k] = v,
+            ))
+            .at(CHART_VR)
+            // X_j and s are angles (rad): the coefficient of s^k has unit
+            // rad^(1-k), which has no name; left without a unit.
+            .describe(
+                "Chart X_{j}(s) = sum_k chart.coef[{j},k] s^k (rad, s = c'q in rad), \
+                 coefficient of s^{k} (curved; default: in-phase mode of the default model \
+                 at the default E_ref)",
+            )
+            .summary(format!(
+                "chart X_j(s) = sum_k chart.coef[j,k] s^k, k = 0..{} (curved)",
+                CHART_COEFFICIENTS - 1
+            ))
+            .start_text("in-phase chart of the default model at the default E_ref")
+            .group(REFERENCE_GROUP),
+        Rw::<N>::enumeration(QP_SOLVER.parameter, Shape::Scalar, QP_SOLVER.fmi_type())
+            .parameter(Field::integer(
+                |s, _| QP_SOLVER.item(s.qp),
+                |s, _, v| s.qp = QP_SOLVER.value(v).unwrap_or(s.qp),
+            ))
+            .describe(
+                "QP solver of the real-time iteration: riccati (structure-exploiting) or clarabel",
+            ),
+    ]);
+    rows.extend(rigid_rows::<Settings<N>, N>("Controller model: "));
+    Table::new(N, rows)
+}

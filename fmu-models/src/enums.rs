@@ -1,0 +1,148 @@
+//! The enumeration parameters (`variant`, `qp_solver`): one table each of
+//! (name, item, library value, description), used by the FMU variable
+//! tables, the C API and the C header.
+
+use eigenmpc::mpc::{QpBackend, Variant};
+use fmi2_slave::EnumerationType;
+
+/// One item of an enumeration.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Item<T> {
+    /// Item name (`curved`).
+    pub name: &'static str,
+    /// Integer value of the item in the FMU and the C API.
+    pub item: i32,
+    /// The library value it selects.
+    pub value: T,
+    /// One-line description.
+    pub description: &'static str,
+}
+
+/// An enumeration: its FMI type name, the parameter that uses it and the items.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Enumeration<T: 'static> {
+    /// FMI `SimpleType` name (`Variant`).
+    pub type_name: &'static str,
+    /// Name of the parameter (`variant`).
+    pub parameter: &'static str,
+    /// The items.
+    pub items: &'static [Item<T>],
+}
+
+impl<T: Copy + PartialEq + std::fmt::Debug + 'static> Enumeration<T> {
+    /// The library value of `item`; the message lists the items.
+    pub fn value(&self, item: i32) -> Result<T, String> {
+        self.items
+            .iter()
+            .find(|i| i.item == item)
+            .map(|i| i.value)
+            .ok_or_else(|| {
+                let list: Vec<String> = self
+                    .items
+                    .iter()
+                    .map(|i| format!("{} {}", i.item, i.name))
+                    .collect();
+                format!(
+                    "{} = {item} is not an item of {} ({})",
+                    self.parameter,
+                    self.type_name,
+                    list.join(", ")
+                )
+            })
+    }
+
+    /// The item of `value` (every library value has one: tested).
+    pub fn item(&self, value: T) -> i32 {
+        self.items
+            .iter()
+            .find(|i| i.value == value)
+            .map(|i| i.item)
+            .unwrap_or_else(|| panic!("{value:?} has no item in {}", self.type_name))
+    }
+
+    /// The FMI enumeration type.
+    pub fn fmi_type(&self) -> EnumerationType {
+        EnumerationType {
+            name: self.type_name.into(),
+            items: self
+                .items
+                .iter()
+                .map(|i| (i.name.into(), i.item, i.description.into()))
+                .collect(),
+        }
+    }
+}
+
+/// `variant`: which EigenMPC cost.
+pub const VARIANT: Enumeration<Variant> = Enumeration {
+    type_name: "Variant",
+    parameter: "variant",
+    items: &[
+        Item {
+            name: "straight",
+            item: 1,
+            value: Variant::Straight,
+            description: "Distance to the linear eigenvector line",
+        },
+        Item {
+            name: "curved",
+            item: 2,
+            value: Variant::Curved,
+            description: "Distance to the eigenmode chart X(s)",
+        },
+    ],
+};
+
+/// `qp_solver`: the QP solver of the real-time iteration.
+pub const QP_SOLVER: Enumeration<QpBackend> = Enumeration {
+    type_name: "QpSolver",
+    parameter: "qp_solver",
+    items: &[
+        Item {
+            name: "clarabel",
+            item: 1,
+            value: QpBackend::Clarabel,
+            description: "clarabel: general-purpose interior point (reference)",
+        },
+        Item {
+            name: "riccati",
+            item: 2,
+            value: QpBackend::Riccati,
+            description: "Riccati-recursion interior point exploiting the stage structure",
+        },
+    ],
+};
+
+/// `variant` item: straight EigenMPC.
+pub const VARIANT_STRAIGHT: i32 = VARIANT.items[0].item;
+/// `variant` item: curved EigenMPC.
+pub const VARIANT_CURVED: i32 = VARIANT.items[1].item;
+/// `qp_solver` item: clarabel.
+pub const QP_SOLVER_CLARABEL: i32 = QP_SOLVER.items[0].item;
+/// `qp_solver` item: Riccati (default).
+pub const QP_SOLVER_RICCATI: i32 = QP_SOLVER.items[1].item;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_library_value_has_one_item_and_back() {
+        for v in [Variant::Straight, Variant::Curved] {
+            assert_eq!(VARIANT.value(VARIANT.item(v)), Ok(v));
+        }
+        for b in QpBackend::ALL {
+            assert_eq!(QP_SOLVER.value(QP_SOLVER.item(b)), Ok(b));
+        }
+        assert_eq!((VARIANT_STRAIGHT, VARIANT_CURVED), (1, 2));
+        assert_eq!((QP_SOLVER_CLARABEL, QP_SOLVER_RICCATI), (1, 2));
+        assert_eq!(
+            VARIANT.value(3),
+            Err("variant = 3 is not an item of Variant (1 straight, 2 curved)".into())
+        );
+        assert_eq!(
+            QP_SOLVER.value(0),
+            Err("qp_solver = 0 is not an item of QpSolver (1 clarabel, 2 riccati)".into())
+        );
+    }
+}

@@ -1,0 +1,25 @@
+//! # EigenMPC FMU models
+//!
+//! The controller ([`controller`]) and plant ([`plant`]) FMUs generic in the
+//! number of joints `N`, each defined by one declarative variable table
+//! ([`fmi2_slave::table`]) from which the value references, the
+//! `modelDescription.xml`, the documentation page, the README tables, the C
+//! header's constants and the start-value files follow.
+//!
+//! This crate exports no symbols: each FMU crate (`controller-fmu`,
+//! `controller3-fmu`, `plant`, `plant3`) picks one product of [`products`]
+//! and invokes `fmi2_slave::export_fmi2!` for it.
+//!
+//! - [`enums`]: the `variant` and `qp_solver` enumerations (name, item,
+//!   description), one table used by the FMU and the C API;
+//! - [`chain`]: the rigid-link parameters shared by controller and plant;
+//! - [`units`]: unit definitions;
+//! - [`readme`]: the README's FMU variable tables.
+
+pub mod chain;
+pub mod controller;
+pub mod enums;
+pub mod plant;
+pub mod products;
+pub mod readme;
+pub mod units;

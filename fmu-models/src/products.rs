@@ -1,0 +1,192 @@
+//! The FMUs this workspace ships: the 2-joint pair `EigenMPC` /
+//! `DoublePendulum` (the paper's) and the 3-link pair `EigenMPC3` /
+//! `TriplePendulum`, each a product of the generic models.
+
+use crate::controller::settings::CHART_COEFFICIENTS;
+use crate::controller::{ControllerFmu, ControllerProduct};
+use crate::plant::{PlantFmu, PlantProduct};
+use eigenmpc::mpc::Variant;
+use fmi2_slave::table::RowDoc;
+
+/// The paper's controller for the double pendulum.
+pub struct EigenMpc2;
+/// The controller for the 3-link chain.
+pub struct EigenMpc3;
+/// The paper's double pendulum.
+pub struct DoublePendulumPlant;
+/// The 3-link chain.
+pub struct TriplePendulumPlant;
+
+/// `EigenMPC.fmu`.
+pub type EigenMpcFmu = ControllerFmu<EigenMpc2, 2, 4>;
+/// `EigenMPC3.fmu`.
+pub type EigenMpc3Fmu = ControllerFmu<EigenMpc3, 3, 6>;
+/// `DoublePendulum.fmu`.
+pub type DoublePendulumFmu = PlantFmu<DoublePendulumPlant, 2, 4>;
+/// `TriplePendulum.fmu`.
+pub type TriplePendulumFmu = PlantFmu<TriplePendulumPlant, 3, 6>;
+
+/// Unit in-phase eigenvector of the paper's double pendulum
+/// (m = l = 1, g = 9.81): `eigenmpc modes --energies 14`, `linear.eigenvector`.
+pub const DEFAULT_EIGENVECTOR: [f64; 2] = [0.923879532511287, 0.38268343236508934];
+
+/// Chart of the paper's 14 J in-phase eigenmode (degree 9) of the default
+/// model, per joint the coefficients of `s^0..s^9`: pasted from
+/// `eigenmpc modes --energies 14 --fmu-start-values FILE`; a test recomputes
+/// it. (The even powers vanish up to fitting noise: the mode is symmetric.)
+pub const DEFAULT_CHART_14J: [[f64; CHART_COEFFICIENTS]; 2] = [
+    [
+        -1.5052159046577842e-13,
+        0.5531221059476479,
+        -5.491549575986848e-13,
+        0.9749828065062158,
+        4.2307952497462395e-12,
+        -1.0166322311774332,
+        -6.984272799679647e-12,
+        0.9510679594842322,
+        4.29172769845075e-12,
+        -0.37213572933988365,
+    ],
+    [
+        3.632493802496032e-13,
+        1.2777710399255753,
+        1.3263274688716941e-12,
+        -2.353816714547903,
+        -1.0200914851325364e-11,
+        2.454367320454213,
+        1.6821919178875235e-11,
+        -2.296081166525384,
+        -1.0333171867907603e-11,
+        0.8984151248159734,
+    ],
+];
+
+/// Energy of the 3-link controller's default chart (J).
+pub const DEFAULT_E_REF_3: f64 = 14.0;
+
+/// Unit in-phase eigenvector of the default 3-link chain (1 kg point masses
+/// at the tips of 1 m links, g = 9.81), from `eigenmpc::modes::linear_modes`;
+/// a test recomputes it.
+pub const DEFAULT_EIGENVECTOR_3: [f64; 3] =
+    [0.9127470240857151, 0.26662501734551874, 0.3095221642276576];
+
+/// Chart of the default 3-link chain's in-phase eigenmode at 14 J (degree
+/// 9), from `eigenmpc::mpc::closed_loop::mode_and_chart`; a test recomputes it.
+pub const DEFAULT_CHART_3_14J: [[f64; CHART_COEFFICIENTS]; 3] = [
+    [
+        5.050409632079176e-14,
+        0.7530956839278246,
+        -7.221472232102508e-13,
+        0.5136321062655385,
+        -1.79879215790722e-12,
+        0.559172639859015,
+        2.402233659413035e-11,
+        -1.3425680845169263,
+        -3.960358850418949e-11,
+        0.6441743726404677,
+    ],
+    [
+        -2.3983751524207863e-13,
+        0.20744508188041463,
+        1.566399554017458e-12,
+        0.8987682977255529,
+        7.725164771839416e-12,
+        -2.073027942331131,
+        3.9890494726943426e-11,
+        -0.9656515470037538,
+        -1.8760711863298372e-10,
+        2.9219070556767104,
+    ],
+    [
+        5.742845048831139e-14,
+        0.8312946109385034,
+        7.943879003957048e-13,
+        -2.2888515632061672,
+        -1.4838973629880835e-12,
+        0.13678486710637783,
+        -1.0472469201172058e-10,
+        4.790906938586926,
+        2.7780039892115887e-10,
+        -4.416555319818698,
+    ],
+];
+
+impl ControllerProduct<2> for EigenMpc2 {
+    const MODEL_NAME: &'static str = "EigenMPC";
+    const DESCRIPTION: &'static str = "EigenMPC controller for the double pendulum: joint \
+                                       angles and speeds in, joint torques out; excites the \
+                                       nonlinear eigenmode at E_ref";
+    const E_REF: f64 = 14.0;
+    const EIGENVECTOR: [f64; 2] = DEFAULT_EIGENVECTOR;
+    const CHART: [[f64; CHART_COEFFICIENTS]; 2] = DEFAULT_CHART_14J;
+}
+
+impl ControllerProduct<3> for EigenMpc3 {
+    const MODEL_NAME: &'static str = "EigenMPC3";
+    const DESCRIPTION: &'static str = "EigenMPC controller for a 3-link planar chain: joint \
+                                       angles and speeds in, joint torques out; excites the \
+                                       nonlinear eigenmode at E_ref";
+    const E_REF: f64 = DEFAULT_E_REF_3;
+    const EIGENVECTOR: [f64; 3] = DEFAULT_EIGENVECTOR_3;
+    const CHART: [[f64; CHART_COEFFICIENTS]; 3] = DEFAULT_CHART_3_14J;
+}
+
+impl PlantProduct<2> for DoublePendulumPlant {
+    const MODEL_NAME: &'static str = "DoublePendulum";
+    const DESCRIPTION: &'static str = "Double pendulum of the EigenMPC paper (rigid links, \
+                                       motors and friction optional): joint torques in, joint \
+                                       angles, speeds and energy out; adaptive Dormand-Prince \
+                                       inside doStep";
+}
+
+impl PlantProduct<3> for TriplePendulumPlant {
+    const MODEL_NAME: &'static str = "TriplePendulum";
+    const DESCRIPTION: &'static str = "Planar 3-link chain (point masses by default; rigid \
+                                       links, motors and friction optional): joint torques in, \
+                                       joint angles, speeds and energy out; adaptive \
+                                       Dormand-Prince inside doStep";
+}
+
+/// The C header's value-reference and enumeration constants of the FMU
+/// `model_identifier`, each prefixed with `prefix`.
+pub fn c_defines(model_identifier: &str, prefix: &str) -> Result<String, String> {
+    use crate::{controller, plant};
+    match model_identifier {
+        "EigenMPC" => controller::table::table::<2>().c_defines(prefix, model_identifier),
+        "EigenMPC3" => controller::table::table::<3>().c_defines(prefix, model_identifier),
+        "DoublePendulum" => plant::table::table::<2>().c_defines(prefix, model_identifier),
+        "TriplePendulum" => plant::table::table::<3>().c_defines(prefix, model_identifier),
+        other => Err(format!("no FMU {other}")),
+    }
+}
+
+/// The controller FMUs' rows in documentation form, `(identifier, rows)`.
+pub fn controller_docs() -> Vec<(&'static str, Vec<RowDoc>)> {
+    use crate::controller::table::table;
+    vec![
+        (
+            EigenMpc2::MODEL_NAME,
+            table::<2>().docs(&EigenMpc2::settings(Variant::Curved)),
+        ),
+        (
+            EigenMpc3::MODEL_NAME,
+            table::<3>().docs(&EigenMpc3::settings(Variant::Curved)),
+        ),
+    ]
+}
+
+/// The plant FMUs' rows in documentation form, `(identifier, rows)`.
+pub fn plant_docs() -> Vec<(&'static str, Vec<RowDoc>)> {
+    use crate::plant::settings::PlantSettings;
+    use crate::plant::table::table;
+    vec![
+        (
+            DoublePendulumPlant::MODEL_NAME,
+            table::<2>().docs(&PlantSettings::default()),
+        ),
+        (
+            TriplePendulumPlant::MODEL_NAME,
+            table::<3>().docs(&PlantSettings::default()),
+        ),
+    ]
+}

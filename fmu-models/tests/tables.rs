@@ -1,0 +1,217 @@
+//! The variable tables: valid FMI 2.0 descriptions, the original 2-joint
+//! value references kept, the 3-joint layout, C constants and README tables.
+
+use eigenmpc_fmu_models::products::*;
+use fmi2_slave::{BaseType, Model, ModelDescription};
+
+fn descriptions() -> Vec<ModelDescription> {
+    vec![
+        EigenMpcFmu::description(),
+        EigenMpc3Fmu::description(),
+        DoublePendulumFmu::description(),
+        TriplePendulumFmu::description(),
+    ]
+}
+
+#[test]
+fn every_description_is_valid() {
+    for d in descriptions() {
+        if let Err(e) = d.validate() {
+            panic!("{}: {e}", d.model_name);
+        }
+    }
+}
+
+fn vr(d: &ModelDescription, name: &str) -> (BaseType, u32) {
+    let v = d
+        .variable(name)
+        .unwrap_or_else(|| panic!("{}: no {name}", d.model_name));
+    (v.var_type.base(), v.value_reference)
+}
+
+/// Every variable of the original `EigenMPC.fmu` keeps its name and value
+/// reference (existing start-value files and hosts keep working).
+#[test]
+fn the_two_joint_controller_keeps_the_original_value_references() {
+    let d = EigenMpcFmu::description();
+    let real = [
+        ("q[1]", 0),
+        ("q[2]", 1),
+        ("qd[1]", 2),
+        ("qd[2]", 3),
+        ("tau[1]", 4),
+        ("tau[2]", 5),
+        ("energy", 6),
+        ("solve_time", 7),
+        ("E_ref", 8),
+        ("alpha", 9),
+        ("beta", 10),
+        ("w_E", 11),
+        ("w_x", 12),
+        ("w_xd", 13),
+        ("w_F", 14),
+        ("tau_max", 15),
+        ("sample_period", 16),
+        ("m[1]", 17),
+        ("m[2]", 18),
+        ("l[1]", 19),
+        ("l[2]", 20),
+        ("g", 21),
+        ("c[1]", 22),
+        ("c[2]", 23),
+    ];
+    for (name, r) in real {
+        assert_eq!(vr(&d, name), (BaseType::Real, r), "{name}");
+    }
+    for j in 1..=2 {
+        for k in 0..10 {
+            let name = format!("chart.coef[{j},{k}]");
+            assert_eq!(
+                vr(&d, &name),
+                (BaseType::Real, 100 + 10 * (j - 1) + k),
+                "{name}"
+            );
+        }
+    }
+    let integer = [
+        ("qp_iterations", 0),
+        ("solver_status", 1),
+        ("variant", 2),
+        ("horizon", 3),
+        ("qp_solver", 4),
+    ];
+    for (name, r) in integer {
+        assert_eq!(vr(&d, name), (BaseType::Integer, r), "{name}");
+    }
+    // the new rigid-link parameters follow the chart block
+    assert_eq!(vr(&d, "r[1]"), (BaseType::Real, 120));
+    assert_eq!(vr(&d, "I[1]"), (BaseType::Real, 122));
+    assert_eq!(vr(&d, "coulomb_sharpness"), (BaseType::Real, 136));
+    assert_eq!(d.variables.len(), 24 + 20 + 5 + 17);
+}
+
+/// Every variable of the original `DoublePendulum.fmu` keeps its name and
+/// value reference.
+#[test]
+fn the_two_link_plant_keeps_the_original_value_references() {
+    let d = DoublePendulumFmu::description();
+    let real = [
+        "tau[1]",
+        "tau[2]",
+        "q[1]",
+        "q[2]",
+        "qd[1]",
+        "qd[2]",
+        "energy",
+        "m[1]",
+        "m[2]",
+        "l[1]",
+        "l[2]",
+        "g",
+        "damping[1]",
+        "damping[2]",
+        "q0[1]",
+        "q0[2]",
+        "qd0[1]",
+        "qd0[2]",
+        "rtol",
+        "atol",
+    ];
+    for (r, name) in real.iter().enumerate() {
+        assert_eq!(vr(&d, name), (BaseType::Real, r as u32), "{name}");
+    }
+    assert_eq!(vr(&d, "r[1]"), (BaseType::Real, 20));
+    assert_eq!(vr(&d, "b[2]"), (BaseType::Real, 29));
+    assert_eq!(vr(&d, "coulomb_sharpness"), (BaseType::Real, 36));
+    assert_eq!(d.variables.len(), 37);
+}
+
+/// The 3-joint layout follows the same function: blocks of 3.
+#[test]
+fn the_three_joint_layout() {
+    let d = EigenMpc3Fmu::description();
+    for (name, r) in [
+        ("q[3]", 2),
+        ("qd[1]", 3),
+        ("tau[3]", 8),
+        ("energy", 9),
+        ("E_ref", 11),
+        ("sample_period", 19),
+        ("m[1]", 20),
+        ("g", 26),
+        ("c[3]", 29),
+        ("chart.coef[3,9]", 129),
+        ("r[1]", 130),
+    ] {
+        assert_eq!(vr(&d, name), (BaseType::Real, r), "{name}");
+    }
+    assert_eq!(vr(&d, "qp_solver"), (BaseType::Integer, 4));
+    let d = TriplePendulumFmu::description();
+    for (name, r) in [
+        ("tau[3]", 2),
+        ("q[1]", 3),
+        ("energy", 9),
+        ("g", 16),
+        ("damping[3]", 19),
+        ("atol", 27),
+        ("r[1]", 28),
+    ] {
+        assert_eq!(vr(&d, name), (BaseType::Real, r), "{name}");
+    }
+}
+
+#[test]
+fn c_header_constants_follow_the_tables() {
+    let h = c_defines("DoublePendulum", "DOUBLE_PENDULUM_").unwrap();
+    for line in [
+        "#define DOUBLE_PENDULUM_VR_TAU1 0\n",
+        "#define DOUBLE_PENDULUM_VR_ENERGY 6\n",
+        "#define DOUBLE_PENDULUM_VR_Q0_1 14\n",
+        "#define DOUBLE_PENDULUM_VR_Q0_2 15\n",
+        "#define DOUBLE_PENDULUM_VR_ATOL 19\n",
+        "#define DOUBLE_PENDULUM_VR_Q_REST2 35\n",
+    ] {
+        assert!(h.contains(line), "{line} missing in\n{h}");
+    }
+    let h = c_defines("EigenMPC", "EIGENMPC_").unwrap();
+    for line in [
+        "#define EIGENMPC_VR_E_REF 8\n",
+        "#define EIGENMPC_VR_CHART_COEF 100\n",
+        "#define EIGENMPC_VR_CHART_COEF_JK(j, k) (100 + 10 * ((j) - 1) + (k))\n",
+        "#define EIGENMPC_VR_QP_SOLVER 4\n",
+        "#define EIGENMPC_VARIANT_STRAIGHT 1\n",
+        "#define EIGENMPC_VARIANT_CURVED 2\n",
+        "#define EIGENMPC_QP_SOLVER_CLARABEL 1\n",
+        "#define EIGENMPC_QP_SOLVER_RICCATI 2\n",
+        "#define EIGENMPC_VR_I1 122\n",
+    ] {
+        assert!(h.contains(line), "{line} missing in\n{h}");
+    }
+    let h = c_defines("EigenMPC3", "EIGENMPC3_").unwrap();
+    assert!(h.contains("#define EIGENMPC3_VR_Q3 2\n"), "{h}");
+    assert!(
+        c_defines("TriplePendulum", "TRIPLE_PENDULUM_")
+            .unwrap()
+            .contains("#define TRIPLE_PENDULUM_VR_TAU3 2\n")
+    );
+}
+
+/// README.md's FMU variable tables are the generated ones (`cargo run -p
+/// fmu-build` rewrites them).
+#[test]
+fn readme_tables_match_the_variable_tables() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../README.md");
+    let readme = std::fs::read_to_string(&path).unwrap();
+    let generated = eigenmpc_fmu_models::readme::update(&readme).unwrap();
+    assert!(
+        generated == readme,
+        "README.md's FMU variable tables are out of date with the variable tables: run \
+         `cargo run -p fmu-build` and commit README.md"
+    );
+    // and the check can fail: a drifted row is noticed
+    let drifted = readme.replacen("| `E_ref` |", "| `E_reference` |", 1);
+    assert_ne!(
+        eigenmpc_fmu_models::readme::update(&drifted).unwrap(),
+        drifted
+    );
+}
