@@ -76,3 +76,19 @@ def eigenmpc_cli() -> pathlib.Path:
     if not path.exists():
         pytest.fail(f"{path} missing: run `cargo build --release --bin eigenmpc` first")
     return path
+
+
+def _unzipped(identifier, tmp_path_factory):
+    directory = tmp_path_factory.mktemp(identifier)
+    extract(str(fmu_path(identifier)), unzipdir=str(directory))
+    return directory
+
+
+@pytest.fixture(scope="session")
+def three_link_pair(tmp_path_factory):
+    """(md, unzipped dir) of EigenMPC3 and of TriplePendulum."""
+    dirs = [_unzipped(i, tmp_path_factory) for i in ("EigenMPC3", "TriplePendulum")]
+    mds = [read_model_description(str(fmu_path(i))) for i in ("EigenMPC3", "TriplePendulum")]
+    yield list(zip(mds, dirs))
+    for d in dirs:
+        shutil.rmtree(d, ignore_errors=True)
