@@ -113,7 +113,8 @@ fn settings_from(config: &EigenMpcConfig) -> Result<Settings<2>, String> {
         sample_period: config.sample_period,
         model: ChainParameters::point_masses(config.masses, config.lengths, config.gravity),
         eigenvector: config.eigenvector,
-        chart: EigenMpc2::CHART,
+        // what the config does not hold: the FMU's defaults (the 14 J chart, ...)
+        ..EigenMpc2::settings(variant)
     })
 }
 

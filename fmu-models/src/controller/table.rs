@@ -10,10 +10,11 @@
 //! role with two accessors into [`Settings`], unit, range and description:
 //!
 //! ```ignore
-//! Rw::<N>::enumeration("chart_source", Scalar, CHART_SOURCE.fmi_type())
+//! // enums.rs: pub const CHART_SOURCE: Enumeration<ChartSource> = ...; Settings: a field
+//! Rw::<N>::enumeration(CHART_SOURCE.parameter, Shape::Scalar, CHART_SOURCE.fmi_type())
 //!     .parameter(Field::integer(
 //!         |s, _| CHART_SOURCE.item(s.chart_source),
-//!         |s, _, v| s.chart_source = CHART_SOURCE.value(v).unwrap_or_default(),
+//!         |s, _, v| s.chart_source = CHART_SOURCE.value(v).unwrap_or(s.chart_source),
 //!     ))
 //!     .describe("Where the curved chart comes from"),
 //! ```
