@@ -215,3 +215,47 @@ fn readme_tables_match_the_variable_tables() {
         drifted
     );
 }
+
+/// `start_values` of the default model with the default reference gives
+/// exactly the FMU's start values of those variables.
+#[test]
+fn start_values_of_the_default_model_are_the_fmu_defaults() {
+    use eigenmpc::mechanics::PlanarChainParams;
+    use eigenmpc_fmu_models::controller::start_values::start_values;
+    let chart = DEFAULT_CHART_14J.map(|r| r.to_vec());
+    let values = start_values(
+        &PlanarChainParams::<2>::default(),
+        14.0,
+        &DEFAULT_EIGENVECTOR,
+        &chart,
+    )
+    .unwrap();
+    let d = EigenMpcFmu::description();
+    assert_eq!(values.len(), 1 + (10 * 2 + 2) + 2 + 20);
+    for (name, value) in &values {
+        assert_eq!(d.variable(name).unwrap().start, Some(*value), "{name}");
+    }
+    // refused: a model the FMU cannot express, too many coefficients
+    let mut behind = PlanarChainParams::<2>::default();
+    behind.links[0].com = -0.2;
+    let e = start_values(&behind, 14.0, &DEFAULT_EIGENVECTOR, &chart).unwrap_err();
+    assert!(e.contains("r[1] = -0.2 < 0"), "{e}");
+    let mut long = chart.clone();
+    long[1].push(0.0);
+    let e = start_values(
+        &PlanarChainParams::default(),
+        14.0,
+        &DEFAULT_EIGENVECTOR,
+        &long,
+    )
+    .unwrap_err();
+    assert!(e.contains("joint 2 has 11 coefficients"), "{e}");
+    let e = start_values(
+        &PlanarChainParams::default(),
+        -1.0,
+        &DEFAULT_EIGENVECTOR,
+        &chart,
+    )
+    .unwrap_err();
+    assert!(e.contains("E_ref = -1 is below its minimum"), "{e}");
+}
