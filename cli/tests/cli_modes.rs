@@ -152,7 +152,12 @@ fn fmu_start_values_carry_the_chart_of_the_requested_mode() {
             );
         }
     }
-    assert_eq!(values.as_object().unwrap().len(), 1 + 5 + 2 + 20);
+    // E_ref, the 22 model parameters of the FMU's table (point masses:
+    // r[j] = I[j] = -1, "at the tip"), c[j] and the 20 chart coefficients.
+    assert_eq!(values.as_object().unwrap().len(), 1 + 22 + 2 + 20);
+    assert_eq!(values["r[1]"], -1.0);
+    assert_eq!(values["I[2]"], -1.0);
+    assert_eq!(values["gr[1]"], 1.0);
     // Lower degree pads with zeros; several energies are refused.
     let (code, _, _) = run(&[
         "modes",

@@ -18,16 +18,6 @@ pub use linear::{Family, LinearMode, linear_modes};
 
 use crate::integrate::IntegrationError;
 
-/// Polynomial degree of the chart parameters `chart.coef[j,k]`, `k = 0..=9`,
-/// of the controller FMU (the paper's degree). One source of truth for the
-/// FMU's variable table and `eigenmpc modes --fmu-start-values`.
-pub const FMU_CHART_DEGREE: usize = 9;
-
-/// Name of the controller FMU's chart parameter for joint `j` (1-based) and
-/// power `k`: `chart.coef[j,k]`.
-pub fn fmu_chart_coef_name(j: usize, k: usize) -> String {
-    format!("chart.coef[{j},{k}]")
-}
 use thiserror::Error;
 
 /// Why a mode, family or chart could not be computed.

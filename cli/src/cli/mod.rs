@@ -135,39 +135,6 @@ impl Robot {
             }
         }
     }
-
-    /// The controller FMU's model parameters for this robot (`m[j]`, `l[j]`,
-    /// `g`, and for a rigid-link robot `r[j]`, `I[j]` about the joint,
-    /// `Ir[j]`, `gr[j]`, `b[j]`, `cf[j]`, `k[j]`, `q_rest[j]`, `coulomb_sharpness`).
-    pub fn fmu_model_values(&self) -> Vec<(String, f64)> {
-        let p = self.system.params();
-        let mut out = vec![];
-        for (j, link) in p.links.iter().enumerate() {
-            out.push((format!("m[{}]", j + 1), link.mass));
-            out.push((format!("l[{}]", j + 1), link.length));
-        }
-        out.push(("g".into(), p.gravity));
-        let point_masses = PlanarChainParams::point_masses(
-            p.links.map(|l| l.mass),
-            p.links.map(|l| l.length),
-            p.gravity,
-        );
-        if *p != point_masses {
-            for (j, (link, joint)) in p.links.iter().zip(&p.joints).enumerate() {
-                let n = j + 1;
-                out.push((format!("r[{n}]"), link.com));
-                out.push((format!("I[{n}]"), link.inertia_about_joint()));
-                out.push((format!("Ir[{n}]"), joint.rotor_inertia));
-                out.push((format!("gr[{n}]"), joint.gear_ratio));
-                out.push((format!("b[{n}]"), joint.viscous));
-                out.push((format!("cf[{n}]"), joint.coulomb));
-                out.push((format!("k[{n}]"), joint.stiffness));
-                out.push((format!("q_rest[{n}]"), joint.rest_angle));
-            }
-            out.push(("coulomb_sharpness".into(), p.coulomb_sharpness));
-        }
-        out
-    }
 }
 
 /// Parses a comma-separated list of numbers (`"2,8,14"`).

@@ -5,9 +5,10 @@ use anyhow::Context;
 use clap::Args;
 use eigenmpc::mechanics::{MechanicalSystem, Vector};
 use eigenmpc::modes::{
-    Chart, ContinuationOptions, FMU_CHART_DEGREE, Family, eigenmode_family_with_progress,
-    fmu_chart_coef_name, linear_modes,
+    Chart, ContinuationOptions, Family, eigenmode_family_with_progress, linear_modes,
 };
+use eigenmpc_fmu_models::controller::start_values::start_values;
+use fmi2_slave::Value;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 use std::io::Write;
@@ -37,34 +38,32 @@ pub struct ModesArgs {
     model: ModelArgs,
 }
 
-/// Start values of the controller FMU for one eigenmode and its chart.
+/// Start values of the controller FMU for one eigenmode and its chart,
+/// generated from the FMU's own variable table (names, ranges, defaults).
 fn fmu_start_values(
     robot: &Robot,
     eigenvector: &Vector<2>,
     energy: f64,
     chart: &Chart<2>,
 ) -> anyhow::Result<serde_json::Map<String, serde_json::Value>> {
-    if chart.degree > FMU_CHART_DEGREE {
-        anyhow::bail!(
-            "--fmu-start-values needs --degree <= {FMU_CHART_DEGREE} (the FMU's chart parameters)"
-        );
-    }
-    let mut values = serde_json::Map::new();
-    let mut put = |name: String, v: f64| {
-        values.insert(name, serde_json::Value::from(v));
-    };
-    put("E_ref".into(), energy);
-    for (name, v) in robot.fmu_model_values() {
-        put(name, v);
-    }
-    for j in 0..2 {
-        put(format!("c[{}]", j + 1), eigenvector[j]);
-        for k in 0..=FMU_CHART_DEGREE {
-            let a = chart.coefficients[j].get(k).copied().unwrap_or(0.0);
-            put(fmu_chart_coef_name(j + 1, k), a);
-        }
-    }
-    Ok(values)
+    let values = start_values::<2>(
+        robot.system.params(),
+        energy,
+        &[eigenvector[0], eigenvector[1]],
+        &chart.coefficients,
+    )
+    .map_err(|e| anyhow::anyhow!("--fmu-start-values: {e}"))?;
+    Ok(values
+        .into_iter()
+        .map(|(name, value)| {
+            let json = match value {
+                Value::Real(v) => serde_json::Value::from(v),
+                Value::Integer(i) => serde_json::Value::from(i),
+                Value::Boolean(b) => serde_json::Value::from(b),
+            };
+            (name, json)
+        })
+        .collect())
 }
 
 #[derive(Serialize)]
