@@ -5,7 +5,9 @@
 use crate::chain::{ChainParameters, HasChain};
 use eigenmpc::mechanics::{MechanicalSystem, PlanarChain, Vector};
 use eigenmpc::modes::Chart;
-use eigenmpc::mpc::{Controller, CostParams, MpcConfig, QpBackend, Reference, Variant, Weights};
+use eigenmpc::mpc::{
+    Controller, CostParams, MpcConfig, QpBackend, Reference, Variant, Weights, prediction_substeps,
+};
 
 /// Number of chart coefficients per joint (powers `0..=9`, the paper's degree).
 pub const CHART_COEFFICIENTS: usize = 10;
@@ -189,6 +191,37 @@ impl<const N: usize> Settings<N> {
     pub fn build<const NX: usize>(&self) -> Result<ChainController<N, NX>, String> {
         let system = self.system()?;
         let reference = self.reference(&system)?;
-        Controller::new(system, self.config(), reference).map_err(|e| e.to_string())
+        let mut config = self.config();
+        // A model with Coulomb friction needs RK4 substeps to predict its
+        // stiff law near zero speed (1 for a frictionless model).
+        config.substeps = prediction_substeps(&system, config.dt);
+        Controller::new(system, config, reference).map_err(|e| e.to_string())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use eigenmpc::mechanics::{Joint, PlanarChainParams};
+
+    /// A controller model with Coulomb friction predicts with substeps;
+    /// the paper's frictionless model keeps one RK4 step per interval.
+    #[test]
+    fn a_friction_model_gets_prediction_substeps() {
+        let mut s = Settings::<2>::paper(
+            Variant::Straight,
+            2.0,
+            [0.92, 0.38],
+            [[0.0; CHART_COEFFICIENTS]; 2],
+        );
+        assert_eq!(s.build::<4>().unwrap().config().substeps, 1);
+        let mut p = PlanarChainParams::<2>::point_masses([0.6, 0.6], [0.3, 0.2], 9.81);
+        p.joints = [Joint {
+            coulomb: 0.09,
+            ..Joint::default()
+        }; 2];
+        s.model = ChainParameters::from_params(&p).unwrap();
+        let c = s.build::<4>().unwrap();
+        assert!(c.config().substeps > 1, "{}", c.config().substeps);
     }
 }
