@@ -185,7 +185,9 @@ def test_start_values_from_eigenmpc_modes_load(controller_md, controller_unzippe
         capture_output=True,
     )
     start = json.loads(path.read_text())
-    assert len(start) == 28
+    # E_ref, the 22 model parameters of the FMU's table, c[j], 20 chart coefficients.
+    assert len(start) == 1 + 22 + 2 + 20
+    assert start["r[1]"] == -1.0  # point mass at the tip
     s = Slave(controller_md, controller_unzipped)
     s.initialize({**start, "q[1]": 0.5, "q[2]": 0.4})
     assert s.get("E_ref")[0] == 8.0
