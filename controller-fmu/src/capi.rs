@@ -19,8 +19,8 @@ use crate::{PendulumController, STATUS_BAD_ARGUMENT};
 use eigenmpc::mpc::{ControlOutput, ControlStatus, Variant};
 use eigenmpc_fmu_models::chain::ChainParameters;
 use eigenmpc_fmu_models::controller::ControllerProduct;
-use eigenmpc_fmu_models::controller::settings::{Settings, Tuning};
-use eigenmpc_fmu_models::enums::{QP_SOLVER, VARIANT};
+use eigenmpc_fmu_models::controller::settings::{ChartSource, Settings, Tuning};
+use eigenmpc_fmu_models::enums::{CHART_SOURCE, QP_SOLVER, VARIANT};
 use eigenmpc_fmu_models::products::EigenMpc2;
 use nalgebra::SVector;
 use std::ffi::{CString, c_char};
@@ -69,6 +69,16 @@ pub struct EigenMpcConfig {
     pub eigenvector: [f64; 2],
     /// QP solver: `EIGENMPC_QP_SOLVER_CLARABEL` (1) or `EIGENMPC_QP_SOLVER_RICCATI` (2, default).
     pub qp_solver: i32,
+    /// Where the reference comes from: `EIGENMPC_CHART_SOURCE_COMPUTED` (1,
+    /// default: linear mode `mode` of the model and its eigenmode family over
+    /// energy, a chart for every E_ref) or `EIGENMPC_CHART_SOURCE_PARAMETERS`
+    /// (2: `eigenvector` and the `chart_coef` of [`eigenmpc_create`]).
+    pub chart_source: i32,
+    /// Computed reference: linear mode, 1 = lowest frequency (in-phase), 2 = anti-phase.
+    pub mode: i32,
+    /// Computed curved reference: top of the family's energy range (J);
+    /// <= 0: max(half the upright potential, 1.25 E_ref).
+    pub family_energy_max: f64,
 }
 
 /// Diagnostics of the last [`eigenmpc_step`].
@@ -113,6 +123,12 @@ fn settings_from(config: &EigenMpcConfig) -> Result<Settings<2>, String> {
         sample_period: config.sample_period,
         model: ChainParameters::point_masses(config.masses, config.lengths, config.gravity),
         eigenvector: config.eigenvector,
+        chart_source: CHART_SOURCE.value(config.chart_source)?,
+        mode: match config.mode {
+            1 | 2 => config.mode as usize - 1,
+            m => return Err(format!("mode = {m} must be 1 (in-phase) or 2 (anti-phase)")),
+        },
+        family_energy_max: config.family_energy_max,
         // what the config does not hold: the FMU's defaults (the 14 J chart, ...)
         ..EigenMpc2::settings(variant)
     })
@@ -171,15 +187,20 @@ pub extern "C" fn eigenmpc_config_default(variant: i32) -> EigenMpcConfig {
         gravity: s.model.gravity,
         eigenvector: s.eigenvector,
         qp_solver: QP_SOLVER.item(s.qp),
+        chart_source: CHART_SOURCE.item(s.chart_source),
+        mode: s.mode as i32 + 1,
+        family_energy_max: s.family_energy_max,
     }
 }
 
 /// Creates a controller (all memory is allocated here; steps do not allocate).
 ///
-/// `chart_coef` (curved only, may be NULL): 20 numbers, the chart
-/// coefficients of joint 1 for powers 0..9, then joint 2 (the FMU's
-/// `chart.coef[j,k]`, from `eigenmpc modes`); NULL selects the 14 J in-phase
-/// chart of the default model. On failure returns NULL and, if `error` is not
+/// `chart_coef` (curved with `chart_source` = parameters only, may be
+/// NULL): 20 numbers, the chart coefficients of joint 1 for powers 0..9,
+/// then joint 2 (the FMU's `chart.coef[j,k]`, from `eigenmpc modes`); NULL
+/// selects the 14 J in-phase chart of the default model. With the default
+/// `chart_source` (computed) the chart family is computed here (about 20 ms)
+/// and `chart_coef` must be NULL. On failure returns NULL and, if `error` is not
 /// NULL, writes the reason into `error` (at most `error_len` bytes, NUL-terminated).
 ///
 /// # Safety
@@ -199,6 +220,13 @@ pub unsafe extern "C" fn eigenmpc_create(
         // SAFETY: non-null, and the caller guarantees it points to a config.
         let config = unsafe { &*config };
         let mut settings = settings_from(config)?;
+        if !chart_coef.is_null() && settings.chart_source != ChartSource::Parameters {
+            return Err(
+                "chart_coef given but chart_source is computed: set chart_source = \
+                 EIGENMPC_CHART_SOURCE_PARAMETERS to use it"
+                    .into(),
+            );
+        }
         if !chart_coef.is_null() {
             // SAFETY: the caller guarantees 2 * CHART_COEFFICIENTS doubles.
             let coef = unsafe { std::slice::from_raw_parts(chart_coef, 2 * CHART_COEFFICIENTS) };

@@ -327,6 +327,10 @@ fn invalid_parameters_are_rejected_with_a_message() {
     // relations checked at exitInitializationMode
     let fmu = Fmu::instantiate();
     assert_eq!(fmu.set(&[vref("c[1]"), vref("c[2]")], &[0.0, 0.0]), OK);
+    assert_eq!(
+        fmu.set_int(&[vref("chart_source")], &[CHART_SOURCE_PARAMETERS]),
+        OK
+    );
     unsafe {
         assert_eq!(fmi2EnterInitializationMode(fmu.c), OK);
         assert_eq!(fmi2ExitInitializationMode(fmu.c), ERROR);
@@ -336,6 +340,106 @@ fn invalid_parameters_are_rejected_with_a_message() {
             .log
             .contains(&["fmi2ExitInitializationMode", "eigenvector"])
     );
+}
+
+/// The chart of the controller behind `fmu`.
+fn chart_in_use(fmu: &Fmu) -> Chart<2> {
+    let instance = unsafe { &*(fmu.c as *const fmi2_slave::Instance<EigenMpcFmu>) };
+    match instance.model().unwrap().controller().reference() {
+        eigenmpc::mpc::Reference::Curved(chart) => chart.clone(),
+        other => panic!("not curved: {other:?}"),
+    }
+}
+
+/// Largest joint-space distance between two charts along s in [-1, 1] rad.
+fn chart_distance(a: &Chart<2>, b: &Chart<2>) -> f64 {
+    (0..=40)
+        .map(|i| {
+            let s = -1.0 + i as f64 / 20.0;
+            (a.eval(s).x - b.eval(s).x).amax()
+        })
+        .fold(0.0, f64::max)
+}
+
+/// The default reference is computed from the model: the in-phase family,
+/// whose chart at the default E_ref is the pasted 14 J chart (to the fit's
+/// accuracy), and a tuned E_ref gets its own chart at the next sample.
+#[test]
+fn computed_chart_follows_a_tuned_e_ref() {
+    let mut fmu = Fmu::start(&[], &[], Z0);
+    assert_eq!(fmu.integer(vref("chart_source")), CHART_SOURCE_COMPUTED);
+    let (lo, hi) = (
+        fmu.real(vref("chart_energy_min")),
+        fmu.real(vref("chart_energy_max")),
+    );
+    assert_eq!(fmu.real(vref("chart_energy")), 14.0);
+    assert!(lo < 1.0 && hi >= 17.5, "{lo} .. {hi} J");
+    let system = DoublePendulum::default();
+    let fitted = |e: f64| {
+        mode_and_chart::<_, 2, 4>(&system, 0, e, CHART_COEFFICIENTS - 1)
+            .unwrap()
+            .1
+    };
+    let d14 = chart_distance(&chart_in_use(&fmu), &fitted(14.0));
+    assert!(d14 < 2e-3, "14 J: computed vs fitted chart {d14} rad");
+    assert_eq!(fmu.step(DT), OK);
+    assert_eq!(fmu.set(&[vref("E_ref")], &[8.0]), OK);
+    assert_eq!(fmu.real(vref("chart_energy")), 8.0);
+    let d8 = chart_distance(&chart_in_use(&fmu), &fitted(8.0));
+    let d8_fixed = chart_distance(&fitted(14.0), &fitted(8.0));
+    assert!(
+        d8 < 2e-3 && d8_fixed > 50.0 * d8,
+        "8 J: {d8} rad (the 14 J chart: {d8_fixed} rad)"
+    );
+    assert_eq!(fmu.step(DT), OK);
+    // Above the family: clamped, said under logStatusWarning, call OK.
+    assert_eq!(fmu.set(&[vref("E_ref")], &[hi + 5.0]), OK);
+    assert_eq!(fmu.real(vref("chart_energy")), hi);
+    assert!(
+        fmu.instance
+            .log
+            .contains(&["outside the chart family's range"])
+    );
+    assert_eq!(fmu.step(DT), OK);
+}
+
+/// chart_source = parameters uses c[j] and chart.coef[j,k] as given;
+/// computed ignores them and says so; mode = 2 computes the anti-phase family.
+#[test]
+fn chart_source_and_mode_select_the_reference() {
+    let anti = mode_and_chart::<_, 2, 4>(&DoublePendulum::default(), 1, 3.0, 9).unwrap();
+    let mut params = vec![(vref("E_ref"), 3.0)];
+    for j in 0..2 {
+        params.push((vref(&format!("c[{}]", j + 1)), anti.1.eigenvector[j]));
+        for (k, a) in anti.1.coefficients[j].iter().enumerate() {
+            params.push((vref(&format!("chart.coef[{},{k}]", j + 1)), *a));
+        }
+    }
+    let given = Fmu::start(
+        &params,
+        &[(vref("chart_source"), CHART_SOURCE_PARAMETERS)],
+        Z0,
+    );
+    assert_eq!(chart_distance(&chart_in_use(&given), &anti.1), 0.0);
+    assert_eq!(given.real(vref("chart_energy_max")), 0.0, "no family");
+
+    let ignored = Fmu::start(&params, &[], Z0);
+    assert!(
+        ignored
+            .instance
+            .log
+            .contains(&["are not used: chart_source = computed"])
+    );
+    let d = chart_distance(&chart_in_use(&ignored), &anti.1);
+    assert!(
+        d > 0.1,
+        "in-phase family, not the given anti-phase chart: {d}"
+    );
+
+    let computed = Fmu::start(&params[..1], &[(vref("mode"), 2)], Z0);
+    let d = chart_distance(&chart_in_use(&computed), &anti.1);
+    assert!(d < 2e-3, "anti-phase family at 3 J vs fitted: {d} rad");
+    assert!(computed.instance.log.lines().iter().all(|l| l.status == OK));
 }
 
 #[test]

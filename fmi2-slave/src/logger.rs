@@ -211,6 +211,13 @@ impl Logger {
         self.log(Category::StatusWarning, Status::Warning, message);
     }
 
+    /// Logs a warning under `logStatusWarning` without changing the call's
+    /// status: for behaviour that is documented and was carried out (some
+    /// masters stop at the first `fmi2Warning`).
+    pub fn notice(&self, message: &str) {
+        self.log(Category::StatusWarning, Status::Warning, message);
+    }
+
     /// Logs an event (`logEvents`).
     pub fn event(&self, message: &str) {
         self.log(Category::Events, Status::Ok, message);

@@ -200,6 +200,9 @@ pub struct Row<S> {
     pub summary: Option<String>,
     /// Start column of the Markdown table (default: the start values).
     pub start_text: Option<String>,
+    /// Range column of the Markdown table (default: from min and max), for
+    /// a range that depends on the number of joints.
+    pub range_text: Option<String>,
     /// Fixed first value reference of the row's block.
     pub at: Option<u32>,
     /// Free tag for selecting rows (e.g. `"model"` for the start-value files).
@@ -223,6 +226,7 @@ impl<S> Row<S> {
             description: String::new(),
             summary: None,
             start_text: None,
+            range_text: None,
             at: None,
             group: None,
             initial_dependencies: Deps::All,
@@ -320,6 +324,12 @@ impl<S> Row<S> {
     /// Sets the Markdown start column.
     pub fn start_text(mut self, text: impl Into<String>) -> Self {
         self.start_text = Some(text.into());
+        self
+    }
+
+    /// Sets the Markdown range column.
+    pub fn range_text(mut self, text: impl Into<String>) -> Self {
+        self.range_text = Some(text.into());
         self
     }
 
@@ -703,21 +713,26 @@ impl<S> Table<S> {
                         values.join(", ")
                     }
                 });
-                let range = match (&row.kind, row.min, row.max) {
-                    (Kind::Enumeration(t), _, _) => t
-                        .items
-                        .iter()
-                        .map(|(name, v, _)| format!("{name} ({v})"))
-                        .collect::<Vec<_>>()
-                        .join(", "),
-                    (_, Some(a), Some(b)) => format!("[{}, {}]", compact(a), compact(b)),
-                    (_, Some(a), None) => format!(">= {}", compact(a)),
-                    (_, None, Some(b)) => format!("<= {}", compact(b)),
-                    (Kind::Real, None, None) if !matches!(row.role, Role::Output { .. }) => {
-                        "finite".into()
-                    }
-                    _ => String::new(),
-                };
+                let range =
+                    row.range_text
+                        .clone()
+                        .unwrap_or_else(|| match (&row.kind, row.min, row.max) {
+                            (Kind::Enumeration(t), _, _) => t
+                                .items
+                                .iter()
+                                .map(|(name, v, _)| format!("{name} ({v})"))
+                                .collect::<Vec<_>>()
+                                .join(", "),
+                            (_, Some(a), Some(b)) => format!("[{}, {}]", compact(a), compact(b)),
+                            (_, Some(a), None) => format!(">= {}", compact(a)),
+                            (_, None, Some(b)) => format!("<= {}", compact(b)),
+                            (Kind::Real, None, None)
+                                if !matches!(row.role, Role::Output { .. }) =>
+                            {
+                                "finite".into()
+                            }
+                            _ => String::new(),
+                        });
                 let meaning = row
                     .summary
                     .clone()

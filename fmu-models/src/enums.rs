@@ -1,7 +1,8 @@
-//! The enumeration parameters (`variant`, `qp_solver`): one table each of
+//! The enumeration parameters (`variant`, `qp_solver`, `chart_source`): one table each of
 //! (name, item, library value, description), used by the FMU variable
 //! tables, the C API and the C header.
 
+use crate::controller::settings::ChartSource;
 use eigenmpc::mpc::{QpBackend, Variant};
 use fmi2_slave::EnumerationType;
 
@@ -113,6 +114,26 @@ pub const QP_SOLVER: Enumeration<QpBackend> = Enumeration {
     ],
 };
 
+/// `chart_source`: where the reference (eigenvector, chart) comes from.
+pub const CHART_SOURCE: Enumeration<ChartSource> = Enumeration {
+    type_name: "ChartSource",
+    parameter: "chart_source",
+    items: &[
+        Item {
+            name: "computed",
+            item: 1,
+            value: ChartSource::Computed,
+            description: "From the model: linear mode `mode`, its eigenmode family over energy",
+        },
+        Item {
+            name: "parameters",
+            item: 2,
+            value: ChartSource::Parameters,
+            description: "The c[j] and chart.coef[j,k] parameters (one fixed chart)",
+        },
+    ],
+};
+
 /// `variant` item: straight EigenMPC.
 pub const VARIANT_STRAIGHT: i32 = VARIANT.items[0].item;
 /// `variant` item: curved EigenMPC.
@@ -121,6 +142,10 @@ pub const VARIANT_CURVED: i32 = VARIANT.items[1].item;
 pub const QP_SOLVER_CLARABEL: i32 = QP_SOLVER.items[0].item;
 /// `qp_solver` item: Riccati (default).
 pub const QP_SOLVER_RICCATI: i32 = QP_SOLVER.items[1].item;
+/// `chart_source` item: computed from the model (default).
+pub const CHART_SOURCE_COMPUTED: i32 = CHART_SOURCE.items[0].item;
+/// `chart_source` item: the chart parameters.
+pub const CHART_SOURCE_PARAMETERS: i32 = CHART_SOURCE.items[1].item;
 
 #[cfg(test)]
 mod tests {
@@ -136,6 +161,10 @@ mod tests {
         }
         assert_eq!((VARIANT_STRAIGHT, VARIANT_CURVED), (1, 2));
         assert_eq!((QP_SOLVER_CLARABEL, QP_SOLVER_RICCATI), (1, 2));
+        for c in [ChartSource::Computed, ChartSource::Parameters] {
+            assert_eq!(CHART_SOURCE.value(CHART_SOURCE.item(c)), Ok(c));
+        }
+        assert_eq!((CHART_SOURCE_COMPUTED, CHART_SOURCE_PARAMETERS), (1, 2));
         assert_eq!(
             VARIANT.value(3),
             Err("variant = 3 is not an item of Variant (1 straight, 2 curved)".into())

@@ -1,8 +1,9 @@
 //! The variable tables: valid FMI 2.0 descriptions, the original 2-joint
 //! value references kept, the 3-joint layout, C constants and README tables.
 
+use eigenmpc_fmu_models::enums::CHART_SOURCE_PARAMETERS;
 use eigenmpc_fmu_models::products::*;
-use fmi2_slave::{BaseType, Model, ModelDescription};
+use fmi2_slave::{BaseType, Model, ModelDescription, Value};
 
 fn descriptions() -> Vec<ModelDescription> {
     vec![
@@ -87,7 +88,12 @@ fn the_two_joint_controller_keeps_the_original_value_references() {
     assert_eq!(vr(&d, "r[1]"), (BaseType::Real, 120));
     assert_eq!(vr(&d, "I[1]"), (BaseType::Real, 122));
     assert_eq!(vr(&d, "coulomb_sharpness"), (BaseType::Real, 136));
-    assert_eq!(d.variables.len(), 24 + 20 + 5 + 17);
+    // then the computed reference
+    assert_eq!(vr(&d, "chart_source"), (BaseType::Integer, 5));
+    assert_eq!(vr(&d, "mode"), (BaseType::Integer, 6));
+    assert_eq!(vr(&d, "family_energy_max"), (BaseType::Real, 137));
+    assert_eq!(vr(&d, "chart_energy_max"), (BaseType::Real, 140));
+    assert_eq!(d.variables.len(), 24 + 20 + 5 + 17 + 6);
 }
 
 /// Every variable of the original `DoublePendulum.fmu` keeps its name and
@@ -231,8 +237,13 @@ fn start_values_of_the_default_model_are_the_fmu_defaults() {
     )
     .unwrap();
     let d = EigenMpcFmu::description();
-    assert_eq!(values.len(), 1 + (10 * 2 + 2) + 2 + 20);
+    assert_eq!(values.len(), 1 + (10 * 2 + 2) + 2 + 20 + 1);
     for (name, value) in &values {
+        if name == "chart_source" {
+            // the file's chart is used, not a computed one
+            assert_eq!(*value, Value::Integer(CHART_SOURCE_PARAMETERS));
+            continue;
+        }
         assert_eq!(d.variable(name).unwrap().start, Some(*value), "{name}");
     }
     // refused: a model the FMU cannot express, too many coefficients

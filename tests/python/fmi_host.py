@@ -21,6 +21,7 @@ class Slave:
     def __init__(self, md, unzipdir, name="instance", logging_on=False):
         self.md = md
         self.vr = {v.name: v.valueReference for v in md.modelVariables}
+        self.type = {v.name: v.type for v in md.modelVariables}
         self.messages = []
 
         def logger(_env, _name, status, category, message):
@@ -42,7 +43,13 @@ class Slave:
         self.time = 0.0
 
     def set_named(self, values: dict):
-        self.fmu.setReal([self.vr[n] for n in values], list(values.values()))
+        """Sets Real values, and Integer / Enumeration ones (start-value files hold both)."""
+        reals = {n: v for n, v in values.items() if self.type[n] == "Real"}
+        integers = {n: int(v) for n, v in values.items() if self.type[n] != "Real"}
+        if reals:
+            self.fmu.setReal([self.vr[n] for n in reals], list(reals.values()))
+        if integers:
+            self.fmu.setInteger([self.vr[n] for n in integers], list(integers.values()))
 
     def get(self, *names):
         return self.fmu.getReal([self.vr[n] for n in names])

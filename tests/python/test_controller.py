@@ -29,7 +29,10 @@ def test_model_description(controller_md):
     assert controller_md.coSimulation.modelIdentifier == "EigenMPC"
     assert [x.name for x in controller_md.modelVariables if x.causality == "input"] == STATE
     outputs = [u.variable.name for u in controller_md.outputs]
-    assert outputs == ["tau[1]", "tau[2]", "energy", "solve_time", "qp_iterations", "solver_status"]
+    assert outputs == [
+        "tau[1]", "tau[2]", "energy", "solve_time", "qp_iterations", "solver_status",
+        "chart_energy", "chart_energy_min", "chart_energy_max",
+    ]
     # step mode: a solve uses the inputs of the step's start, so inputs set
     # at a communication point do not change the outputs there
     assert all(u.dependencies == [] for u in controller_md.outputs)
@@ -133,7 +136,10 @@ def test_trajectory_matches_the_native_simulation(scenario_14, eigenmpc_cli, tmp
     rows, _ = scenario_14
     path = tmp_path / "native.csv"
     subprocess.run(
-        [str(eigenmpc_cli), "simulate", "--variant", "curved", "--energy", "14", "--duration", "30", "--csv", str(path)],
+        [
+            str(eigenmpc_cli), "simulate", "--variant", "curved", "--energy", "14", "--chart-family",
+            "--duration", "30", "--csv", str(path),
+        ],
         check=True,
         capture_output=True,
     )
@@ -144,9 +150,9 @@ def test_trajectory_matches_the_native_simulation(scenario_14, eigenmpc_cli, tmp
     # Same controller, same sample instants; the plants differ only in their
     # integrator runs (the FMU's Dormand-Prince at its default 1e-12
     # tolerances restarts when the torque changes, the native loop's at
-    # 1e-10 does not) and the chart (fitted afresh vs the FMU's pasted
-    # coefficients, equal to ~1e-12): differences of that size, amplified by
-    # the closed loop over 30 s.
+    # 1e-10 does not); both compute the same chart family (the FMU's default
+    # chart_source = computed, the CLI's --chart-family): differences of that
+    # size, amplified by the closed loop over 30 s.
     de = np.max(np.abs(native[:, 7] - rows[:, 7]))
     dtau = np.max(np.abs(native[:, 5:7] - rows[:, 5:7]))
     dq = np.max(np.abs(native[:, 1:3] - rows[:, 1:3]))
@@ -163,15 +169,18 @@ def test_e_ref_changed_mid_run_is_followed(controller_md, controller_unzipped, p
     before = rows[rows[:, 0] <= 30.0]
     after = rows[rows[:, 0] > 45.0]
     assert abs(before[-1, 7] - 14.0) < 0.05 * 14.0
-    # The chart is still the 14 J mode's, which biases the curved cost at
-    # 8 J: the energy settles about 4.5 % above 8 J (the C test sees the
-    # same) and swings +-1 % along the orbit.
+    # The computed chart follows E_ref (chart_source = computed, the
+    # default): the energy settles at 8 J. With the fixed 14 J chart it
+    # settled 4.5 % above and swung +-1 % along the orbit.
     mean = after[:, 7].mean()
+    rms_tau = np.sqrt(np.mean(after[:, 5:7] ** 2, axis=0))
     FIGURES.append(
-        f"E_ref 14 -> 8 J at 30 s: E in the last 10 s {after[:, 7].min():.3f}..{after[:, 7].max():.3f} J, mean {mean:.3f} J"
+        f"E_ref 14 -> 8 J at 30 s: E in the last 10 s {after[:, 7].min():.4f}..{after[:, 7].max():.4f} J, "
+        f"mean {mean:.4f} J, RMS tau {rms_tau[0]:.4f} / {rms_tau[1]:.4f} N m"
     )
-    assert abs(mean - 8.0) < 0.05 * 8.0
-    assert np.all(np.abs(after[:, 7] - 8.0) < 0.07 * 8.0)
+    assert abs(mean - 8.0) < 0.01 * 8.0
+    assert np.all(np.abs(after[:, 7] - 8.0) < 0.02 * 8.0)
+    assert np.all(rms_tau < 0.05)
     assert np.all(np.abs(rows[:, 5:7]) <= 1.0 + 1e-12)
     assert np.all(rows[:, 8] == 0)
 
@@ -185,8 +194,10 @@ def test_start_values_from_eigenmpc_modes_load(controller_md, controller_unzippe
         capture_output=True,
     )
     start = json.loads(path.read_text())
-    # E_ref, the 22 model parameters of the FMU's table, c[j], 20 chart coefficients.
-    assert len(start) == 1 + 22 + 2 + 20
+    # E_ref, the 22 model parameters of the FMU's table, c[j], 20 chart
+    # coefficients, and chart_source = parameters (use this chart).
+    assert len(start) == 1 + 22 + 2 + 20 + 1
+    assert start["chart_source"] == 2
     assert start["r[1]"] == -1.0  # point mass at the tip
     s = Slave(controller_md, controller_unzipped)
     s.initialize({**start, "q[1]": 0.5, "q[2]": 0.4})
@@ -219,8 +230,10 @@ def test_bad_calls_are_errors_not_crashes(controller_md, controller_unzipped):
     s.fmu.reset()
     expect_error(s, lambda: s.fmu.setInteger([s.vr["variant"]], [5]), "variant = 5 is above its maximum")
     s.fmu.reset()
-    # a relation only checked when the controller is built
+    # a relation only checked when the controller is built (with the
+    # eigenvector taken from the parameters)
     s.set_named({"c[1]": 0.0, "c[2]": 0.0})
+    s.fmu.setInteger([s.vr["chart_source"]], [2])
     s.fmu.setupExperiment(startTime=0.0)
     s.fmu.enterInitializationMode()
     expect_error(s, s.fmu.exitInitializationMode, "eigenvector")

@@ -26,7 +26,7 @@ use eigenmpc::mpc::{ControlOutput, MpcConfig, Variant};
 use fmi2_slave::table::{Element, Table};
 use fmi2_slave::{Context, DefaultExperiment, Model, ModelDescription, ModelError, Values};
 use nalgebra::SVector;
-use settings::{CHART_COEFFICIENTS, ChainController, Settings};
+use settings::{CHART_COEFFICIENTS, ChainController, ChartSource, Settings, chart_clamp_warning};
 use std::marker::PhantomData;
 use timing::{SampleClock, Tick};
 
@@ -60,6 +60,7 @@ struct Io<const N: usize> {
     solve_time: u32,
     qp_iterations: u32,
     solver_status: u32,
+    chart_energy: [u32; 3],
 }
 
 impl<const N: usize> Io<N> {
@@ -80,6 +81,11 @@ impl<const N: usize> Io<N> {
             solve_time: scalar("solve_time")?,
             qp_iterations: scalar("qp_iterations")?,
             solver_status: scalar("solver_status")?,
+            chart_energy: [
+                scalar("chart_energy")?,
+                scalar("chart_energy_min")?,
+                scalar("chart_energy_max")?,
+            ],
         })
     }
 }
@@ -129,8 +135,17 @@ impl<P: ControllerProduct<N> + Send, const N: usize, const NX: usize> Model
     fn initialize(values: &mut Values, ctx: &Context) -> Result<Self, ModelError> {
         let table = table::table::<N>();
         let io = Io::new(&table).map_err(ModelError::Error)?;
-        let mut settings = P::settings(Variant::Curved);
+        let defaults = P::settings(Variant::Curved);
+        let mut settings = defaults.clone();
         table.read(values, &mut settings, |_| true);
+        if settings.chart_source == ChartSource::Computed
+            && (settings.eigenvector != defaults.eigenvector || settings.chart != defaults.chart)
+        {
+            ctx.log.notice(
+                "c[j] / chart.coef[j,k] were set but are not used: chart_source = computed \
+                 takes the reference from the model; set chart_source = parameters to use them",
+            );
+        }
         let controller = settings.build::<NX>().map_err(ModelError::Error)?;
         let mut model = Self {
             controller,
@@ -141,6 +156,7 @@ impl<P: ControllerProduct<N> + Send, const N: usize, const NX: usize> Model
             solved_state: SVector::zeros(),
             product: PhantomData,
         };
+        model.report_chart(values, ctx);
         model.solve(values, ctx.experiment.start_time, ctx);
         Ok(model)
     }
@@ -164,13 +180,17 @@ impl<P: ControllerProduct<N> + Send, const N: usize, const NX: usize> Model
         Ok(())
     }
 
-    fn update_tunables(&mut self, values: &mut Values, _ctx: &Context) -> Result<(), ModelError> {
+    fn update_tunables(&mut self, values: &mut Values, ctx: &Context) -> Result<(), ModelError> {
         let mut settings = self.settings.clone();
         self.table.read(values, &mut settings, |r| r.is_tunable());
         self.controller
             .set_cost(settings.tuning.cost(settings.variant))
             .map_err(|e| ModelError::Error(e.to_string()))?;
+        let moved = settings.tuning.e_ref != self.settings.tuning.e_ref;
         self.settings = settings;
+        if moved {
+            self.report_chart(values, ctx);
+        }
         Ok(())
     }
 }
@@ -184,6 +204,20 @@ impl<P, const N: usize, const NX: usize> ControllerFmu<P, N, NX> {
                 values.real(self.io.qd[i - N])
             }
         })
+    }
+
+    /// Writes the chart-energy outputs and warns when `E_ref` is clamped to
+    /// the computed family's range (set-up and tuning only: may allocate).
+    fn report_chart(&self, values: &mut Values, ctx: &Context) {
+        let range = self.controller.family().map(|f| f.energy_range());
+        let (lo, hi) = range.unwrap_or((0.0, 0.0));
+        let used = self.controller.chart_energy().unwrap_or(0.0);
+        for (vr, v) in self.io.chart_energy.iter().zip([used, lo, hi]) {
+            values.set_real(*vr, v);
+        }
+        if let Some(warning) = chart_clamp_warning(&self.controller) {
+            ctx.log.notice(&warning);
+        }
     }
 
     /// One controller sample with the current inputs; writes the outputs.

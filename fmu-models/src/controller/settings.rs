@@ -4,7 +4,7 @@
 
 use crate::chain::{ChainParameters, HasChain};
 use eigenmpc::mechanics::{MechanicalSystem, PlanarChain, Vector};
-use eigenmpc::modes::Chart;
+use eigenmpc::modes::{Chart, ChartFamily, FamilyOptions, linear_modes};
 use eigenmpc::mpc::{
     Controller, CostParams, MpcConfig, QpBackend, Reference, Variant, Weights, prediction_substeps,
 };
@@ -77,6 +77,17 @@ impl Tuning {
     }
 }
 
+/// Where the controller's reference (eigenvector line, chart) comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ChartSource {
+    /// Computed from the controller's model at creation: the linear mode
+    /// `mode` (straight) or its eigenmode family over energy, a chart for
+    /// every `E_ref` in the family's range (curved).
+    Computed,
+    /// The `c[j]` and `chart.coef[j,k]` parameters: one fixed chart.
+    Parameters,
+}
+
 /// One controller's full definition.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Settings<const N: usize> {
@@ -98,6 +109,15 @@ pub struct Settings<const N: usize> {
     pub eigenvector: [f64; N],
     /// Chart coefficients (curved): joint, power.
     pub chart: [[f64; CHART_COEFFICIENTS]; N],
+    /// Reference computed from the model, or `eigenvector` and `chart`.
+    pub chart_source: ChartSource,
+    /// Linear mode of the computed reference, 0-based in ascending
+    /// frequency (0: in-phase).
+    pub mode: usize,
+    /// Top of the computed family's energy range (J); `<= 0`: the default
+    /// of [`FamilyOptions::for_system`] (half the upright potential, at
+    /// least 1.25 `E_ref`).
+    pub family_energy_max: f64,
 }
 
 impl<const N: usize> HasChain<N> for Settings<N> {
@@ -132,6 +152,9 @@ impl<const N: usize> Settings<N> {
             model: ChainParameters::default(),
             eigenvector,
             chart,
+            chart_source: ChartSource::Computed,
+            mode: 0,
+            family_energy_max: -1.0,
         }
     }
 
@@ -188,15 +211,90 @@ impl<const N: usize> Settings<N> {
     }
 
     /// Builds the controller (`NX = 2 N`); the message names what is wrong.
+    /// A computed curved reference continues the mode family at creation
+    /// (tens of milliseconds for 2 links, see `cargo bench --bench modes`).
     pub fn build<const NX: usize>(&self) -> Result<ChainController<N, NX>, String> {
         let system = self.system()?;
-        let reference = self.reference(&system)?;
         let mut config = self.config();
         // A model with Coulomb friction needs RK4 substeps to predict its
         // stiff law near zero speed (1 for a frictionless model).
         config.substeps = prediction_substeps(&system, config.dt);
-        Controller::new(system, config, reference).map_err(|e| e.to_string())
+        match (self.chart_source, self.variant) {
+            (ChartSource::Parameters, _) => {
+                let reference = self.reference(&system)?;
+                Controller::new(system, config, reference).map_err(|e| e.to_string())
+            }
+            (ChartSource::Computed, Variant::Straight) => {
+                let eigenvector = self.linear_mode(&system)?;
+                Controller::new(system, config, Reference::Straight { eigenvector })
+                    .map_err(|e| e.to_string())
+            }
+            (ChartSource::Computed, Variant::Curved) => {
+                let family = self.family::<NX>(&system)?;
+                Controller::with_family(system, config, family).map_err(|e| e.to_string())
+            }
+        }
     }
+
+    /// The unit eigenvector of linear mode `mode` of `system`.
+    fn linear_mode(&self, system: &PlanarChain<N>) -> Result<Vector<N>, String> {
+        let modes = linear_modes(system).map_err(|e| format!("linear modes of the model: {e}"))?;
+        modes
+            .get(self.mode)
+            .map(|m| m.eigenvector)
+            .ok_or_else(|| format!("mode = {} must be 1..={N}", self.mode + 1))
+    }
+
+    /// The family options of the computed chart.
+    pub fn family_options(&self, system: &PlanarChain<N>) -> FamilyOptions {
+        let mut opts = if self.family_energy_max > 0.0 {
+            FamilyOptions::up_to(self.family_energy_max)
+        } else {
+            FamilyOptions::for_system(system, &[self.tuning.e_ref])
+        };
+        opts.degree = CHART_COEFFICIENTS - 1;
+        opts
+    }
+
+    /// The eigenmode family of linear mode `mode` of `system` (curved,
+    /// computed), with charts of the FMU's degree.
+    pub fn family<const NX: usize>(
+        &self,
+        system: &PlanarChain<N>,
+    ) -> Result<ChartFamily<N>, String> {
+        self.linear_mode(system)?;
+        let opts = self.family_options(system);
+        ChartFamily::compute::<_, NX>(system, self.mode, &opts).map_err(|e| {
+            format!(
+                "the mode family of mode {} up to {} J could not be computed: {e} (lower \
+                 family_energy_max, or bring a chart with chart_source = parameters)",
+                self.mode + 1,
+                opts.energy_max
+            )
+        })
+    }
+}
+
+/// Why `E_ref` does not get its own chart (None: it does): outside the
+/// computed family's range it is clamped to the chart at the range end.
+pub fn chart_clamp_warning<const N: usize, const NX: usize>(
+    controller: &ChainController<N, NX>,
+) -> Option<String> {
+    let family = controller.family()?;
+    let e_ref = controller.config().cost.e_ref;
+    let (lo, hi) = family.energy_range();
+    if (lo..=hi).contains(&e_ref) {
+        return None;
+    }
+    let ended = family
+        .ended_early()
+        .map(|why| format!("; the family ends there: {why}"))
+        .unwrap_or_default();
+    Some(format!(
+        "E_ref = {e_ref} J is outside the chart family's range {lo:.6} .. {hi:.6} J: the chart \
+         of {:.6} J is used (raise family_energy_max for a higher E_ref){ended}",
+        family.clamp(e_ref)
+    ))
 }
 
 #[cfg(test)]

@@ -2,7 +2,7 @@
 //! the same table as the FMU (what `eigenmpc modes --fmu-start-values`
 //! writes).
 
-use super::settings::{CHART_COEFFICIENTS, Settings};
+use super::settings::{CHART_COEFFICIENTS, ChartSource, Settings};
 use super::table::{REFERENCE_GROUP, table};
 use crate::chain::{ChainParameters, MODEL_GROUP};
 use eigenmpc::mechanics::PlanarChainParams;
@@ -13,8 +13,9 @@ use fmi2_slave::Value;
 /// controller FMU control `model` at `e_ref` along the chart
 /// `X_j(s) = sum_k chart[j][k] s^k` in `s = c'q` with the unit eigenvector
 /// `eigenvector`: `E_ref`, every model parameter (`m[j]`, `l[j]`, `g`,
-/// `r[j]`, `I[j]`, `Ir[j]`, ...), `c[j]` and `chart.coef[j,k]` (zero-padded
-/// to 10 powers).
+/// `r[j]`, `I[j]`, `Ir[j]`, ...), `c[j]`, `chart.coef[j,k]` (zero-padded
+/// to 10 powers) and `chart_source = parameters`, which makes the FMU use
+/// this chart instead of computing its own.
 ///
 /// Refused (the message names the variable): a model the FMU cannot
 /// express or that is not physical, more than 10 coefficients per joint,
@@ -33,6 +34,7 @@ pub fn start_values<const N: usize>(
         [[0.0; CHART_COEFFICIENTS]; N],
     );
     settings.model = ChainParameters::from_params(model)?;
+    settings.chart_source = ChartSource::Parameters;
     for (j, row) in chart.iter().enumerate() {
         if row.len() > CHART_COEFFICIENTS {
             return Err(format!(

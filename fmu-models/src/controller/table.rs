@@ -16,12 +16,12 @@
 //!         |s, _| CHART_SOURCE.item(s.chart_source),
 //!         |s, _, v| s.chart_source = CHART_SOURCE.value(v).unwrap_or(s.chart_source),
 //!     ))
-//!     .describe("Where the curved chart comes from"),
+//!     .describe("Where the reference comes from"),
 //! ```
 
 use super::settings::{CHART_COEFFICIENTS, Settings};
 use crate::chain::{point_mass_rows, rigid_rows};
-use crate::enums::{QP_SOLVER, VARIANT};
+use crate::enums::{CHART_SOURCE, QP_SOLVER, VARIANT};
 use fmi2_slave::table::{Deps, Field, Row, Shape, Table};
 
 /// Group tag of the reference rows (`E_ref`, `c[j]`, `chart.coef[j,k]`),
@@ -224,5 +224,70 @@ pub fn table<const N: usize>() -> Table<Settings<N>> {
             ),
     ]);
     rows.extend(rigid_rows::<Settings<N>, N>("Controller model: "));
+    rows.extend(computed_reference_rows::<N>());
     Table::new(N, rows)
+}
+
+/// The rows of the reference computed from the model (`chart_source`).
+fn computed_reference_rows<const N: usize>() -> Vec<Rw<N>> {
+    let chart_energy = |name, what: &str| {
+        Rw::<N>::real(name, Shape::Scalar)
+            .discrete_output()
+            .unit("J")
+            .describe(what.to_string())
+    };
+    vec![
+        Rw::<N>::enumeration(
+            CHART_SOURCE.parameter,
+            Shape::Scalar,
+            CHART_SOURCE.fmi_type(),
+        )
+        .parameter(Field::integer(
+            |s, _| CHART_SOURCE.item(s.chart_source),
+            |s, _, v| s.chart_source = CHART_SOURCE.value(v).unwrap_or(s.chart_source),
+        ))
+        .describe(
+            "Where the reference comes from: computed (default) from the controller model \
+             at creation, linear mode `mode` and its eigenmode family over energy, so that \
+             every E_ref gets its own chart; or parameters: c[j] and chart.coef[j,k], one \
+             fixed chart",
+        )
+        .group(REFERENCE_GROUP),
+        Rw::<N>::integer("mode", Shape::Scalar)
+            .parameter(Field::integer(
+                |s, _| s.mode as i32 + 1,
+                |s, _, v| s.mode = (v.max(1) - 1) as usize,
+            ))
+            .range(1.0, N as f64)
+            .range_text("[1, number of joints]")
+            .describe(
+                "Computed reference: linear mode, 1 = lowest frequency (the in-phase mode of \
+                 a pendulum), up to the number of joints",
+            ),
+        Rw::<N>::real("family_energy_max", Shape::Scalar)
+            .parameter(Field::real(
+                |s, _| s.family_energy_max,
+                |s, _, v| s.family_energy_max = v,
+            ))
+            .unit("J")
+            .range(-1.0, 1e4)
+            .describe(
+                "Computed curved reference: top of the mode family's energy range; \
+                 **<= 0 = max(half the potential with every link upright, 1.25 E_ref)**",
+            ),
+        chart_energy(
+            "chart_energy",
+            "Energy of the chart in use: E_ref clamped to chart_energy_min..chart_energy_max \
+             (an E_ref outside is logged as a warning); 0 for a fixed chart or straight",
+        ),
+        chart_energy(
+            "chart_energy_min",
+            "Lowest energy of the computed mode family (0 for a fixed chart or straight)",
+        ),
+        chart_energy(
+            "chart_energy_max",
+            "Highest energy of the computed mode family: where the continuation or the \
+             chart fit ended, or family_energy_max (0 for a fixed chart or straight)",
+        ),
+    ]
 }
