@@ -22,6 +22,21 @@ bash demo/run.sh --no-build --out-dir target/demo-ci
 for f in demo.csv demo.png demo.svg; do
     test -s "target/demo-ci/$f" || { echo "demo did not write target/demo-ci/$f" >&2; exit 1; }
 done
+# The README's two other demo runs: a robot parameter file, 3 links. Each
+# must bring the energy into the 5 % band.
+demo_reaches_band() {
+    local out
+    out=$(bash demo/run.sh --no-build "$@")
+    echo "$out"
+    grep -q "5 % for good: [0-9]" <<<"$out" || { echo "demo $*: 5 % band not reached" >&2; exit 1; }
+}
+demo_reaches_band --model robots/lab-double-pendulum-A0.yml --energy 2 --tau-max 0.5 \
+    --duration 30 --out-dir target/demo-ci-A0
+demo_reaches_band --links 3 --out-dir target/demo-ci-3
+if bash demo/run.sh --no-build --links 4 --out-dir target/demo-ci-4 2>/dev/null; then
+    echo "demo --links 4 should be refused" >&2
+    exit 1
+fi
 
 echo "== C host tests (gcc, include/eigenmpc.h, linked FMU libraries)"
 target_dir=${CARGO_TARGET_DIR:-target}

@@ -15,7 +15,7 @@ pub struct PlotError(String);
 
 /// The summary figures as aligned text lines (time to 5 %, final energy
 /// error, RMS torque and distance over the last 5 s, solve times).
-pub fn summary_text(s: &Summary<2>) -> String {
+pub fn summary_text<const N: usize>(s: &Summary<N>) -> String {
     let ms = |t: f64| t * 1e3;
     let mut out = String::new();
     let _ = match s.time_to_5_percent {
@@ -27,10 +27,11 @@ pub fn summary_text(s: &Summary<2>) -> String {
         "final energy error:              {:+.4} J",
         s.final_energy_error
     );
+    let torques: Vec<String> = s.rms_torque.iter().map(|t| format!("{t:.4}")).collect();
     let _ = writeln!(
         out,
-        "RMS torque, last 5 s:            {:.4} / {:.4} N m",
-        s.rms_torque[0], s.rms_torque[1]
+        "RMS torque, last 5 s:            {} N m",
+        torques.join(" / ")
     );
     if let Some(d) = s.rms_distance {
         let _ = writeln!(out, "RMS distance to the mode, last 5 s: {d:.4} rad");
@@ -50,47 +51,72 @@ pub fn summary_text(s: &Summary<2>) -> String {
 }
 
 /// Writes a run as CSV with the columns
-/// `time,q1,q2,qd1,qd2,tau1,tau2,energy,solve_ms`.
-pub fn write_csv(path: &Path, trace: &[Sample<2, 4>]) -> std::io::Result<()> {
+/// `time,q1..qN,qd1..qdN,tau1..tauN,energy,solve_ms`.
+pub fn write_csv<const N: usize, const NX: usize>(
+    path: &Path,
+    trace: &[Sample<N, NX>],
+) -> std::io::Result<()> {
     let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
-    writeln!(f, "time,q1,q2,qd1,qd2,tau1,tau2,energy,solve_ms")?;
+    let names = |base: &'static str| (1..=N).map(move |j| format!("{base}{j}"));
+    let header: Vec<String> = std::iter::once("time".to_string())
+        .chain(names("q"))
+        .chain(names("qd"))
+        .chain(names("tau"))
+        .chain(["energy".to_string(), "solve_ms".to_string()])
+        .collect();
+    writeln!(f, "{}", header.join(","))?;
     for s in trace {
-        let z = &s.state;
-        writeln!(
-            f,
-            "{},{},{},{},{},{},{},{},{}",
-            s.time,
-            z[0],
-            z[1],
-            z[2],
-            z[3],
-            s.tau[0],
-            s.tau[1],
-            s.energy,
-            s.solve_time * 1e3
-        )?;
+        write!(f, "{}", s.time)?;
+        for v in s.state.iter().chain(s.tau.iter()) {
+            write!(f, ",{v}")?;
+        }
+        writeln!(f, ",{},{}", s.energy, s.solve_time * 1e3)?;
     }
     f.flush()
 }
 
-/// One plotted quantity of a sample.
-type SampleValue = fn(&Sample<2, 4>) -> f64;
+/// One plotted quantity of a sample over time.
+#[derive(Clone, Copy)]
+enum Panel {
+    Energy,
+    Angle(usize),
+    Torque(usize),
+}
+
+impl Panel {
+    fn value<const N: usize, const NX: usize>(self, s: &Sample<N, NX>) -> f64 {
+        match self {
+            Panel::Energy => s.energy,
+            Panel::Angle(j) => s.state[j],
+            Panel::Torque(j) => s.tau[j],
+        }
+    }
+
+    fn title_and_label(self) -> (String, String) {
+        match self {
+            Panel::Energy => ("energy".into(), "E (J)".into()),
+            Panel::Angle(j) => (format!("theta{}", j + 1), format!("theta{} (rad)", j + 1)),
+            Panel::Torque(j) => (format!("tau{}", j + 1), format!("tau{} (N m)", j + 1)),
+        }
+    }
+}
 
 const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
-/// Draws the paper-style panels of a run (joint-space path with the true
-/// eigenmode, energy, theta1, theta2, tau1, tau2): PNG, or SVG when the file
-/// name ends in `.svg`.
-pub fn plot_run(
+/// Draws the paper-style panels of a run (joint-space path in theta1,
+/// theta2 with the true eigenmode, energy, every theta_j, every tau_j): PNG,
+/// or SVG when the file name ends in `.svg`.
+pub fn plot_run<const N: usize, const NX: usize>(
     path: &Path,
-    trace: &[Sample<2, 4>],
-    mode: &[Vector<2>],
+    trace: &[Sample<N, NX>],
+    mode: &[Vector<N>],
     e_ref: f64,
 ) -> Result<(), PlotError> {
+    const { assert!(N >= 2, "the joint-space panel needs two joints") };
     // The font ships with the binary: no system fontconfig needed.
     plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
         .map_err(|_| PlotError("embedded font is invalid".into()))?;
-    let size = (1500, 900);
+    let size = (500 * (N as u32 + 1), 900);
     let svg = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("svg"));
@@ -111,10 +137,10 @@ pub fn plot_run(
     }
 }
 
-fn draw<DB: DrawingBackend>(
+fn draw<DB: DrawingBackend, const N: usize, const NX: usize>(
     root: DrawingArea<DB, plotters::coord::Shift>,
-    trace: &[Sample<2, 4>],
-    mode: &[Vector<2>],
+    trace: &[Sample<N, NX>],
+    mode: &[Vector<N>],
     e_ref: f64,
 ) -> Result<(), PlotError>
 where
@@ -122,7 +148,7 @@ where
 {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| PlotError(format!("{e:?}"));
     root.fill(&WHITE).map_err(err)?;
-    let panels = root.split_evenly((2, 3));
+    let panels = root.split_evenly((2, N + 1));
     let t_end = trace.last().map_or(1.0, |s| s.time).max(1e-9);
     let range = |vals: &mut dyn Iterator<Item = f64>| {
         let (lo, hi) = vals.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
@@ -183,20 +209,19 @@ where
             .map_err(err)?;
     }
 
-    let series: [(&str, &str, SampleValue); 5] = [
-        ("energy", "E (J)", |s| s.energy),
-        ("theta1", "theta1 (rad)", |s| s.state[0]),
-        ("theta2", "theta2 (rad)", |s| s.state[1]),
-        ("tau1", "tau1 (N m)", |s| s.tau[0]),
-        ("tau2", "tau2 (N m)", |s| s.tau[1]),
-    ];
-    for (panel, (title, label, f)) in panels[1..].iter().zip(series.iter()) {
-        let mut ys = range(&mut trace.iter().map(f));
-        if *title == "energy" {
+    let series: Vec<Panel> = std::iter::once(Panel::Energy)
+        .chain((0..N).map(Panel::Angle))
+        .chain((0..N).map(Panel::Torque))
+        .collect();
+    for (panel, what) in panels[1..].iter().zip(series) {
+        let (title, label) = what.title_and_label();
+        let energy = matches!(what, Panel::Energy);
+        let mut ys = range(&mut trace.iter().map(|s| what.value(s)));
+        if energy {
             ys = ys.start.min(e_ref * 0.9)..ys.end.max(e_ref * 1.1);
         }
         let mut chart = ChartBuilder::on(panel)
-            .caption(*title, ("sans-serif", 20))
+            .caption(&title, ("sans-serif", 20))
             .margin(10)
             .x_label_area_size(35)
             .y_label_area_size(45)
@@ -205,13 +230,16 @@ where
         chart
             .configure_mesh()
             .x_desc("time (s)")
-            .y_desc(*label)
+            .y_desc(&label)
             .draw()
             .map_err(err)?;
         chart
-            .draw_series(LineSeries::new(trace.iter().map(|s| (s.time, f(s))), BLUE))
+            .draw_series(LineSeries::new(
+                trace.iter().map(|s| (s.time, what.value(s))),
+                BLUE,
+            ))
             .map_err(err)?;
-        if *title == "energy" {
+        if energy {
             chart
                 .draw_series(LineSeries::new([(0.0, e_ref), (t_end, e_ref)], RED))
                 .map_err(err)?;

@@ -153,8 +153,10 @@ fn fmu_start_values_carry_the_chart_of_the_requested_mode() {
         }
     }
     // E_ref, the 22 model parameters of the FMU's table (point masses:
-    // r[j] = I[j] = -1, "at the tip"), c[j] and the 20 chart coefficients.
-    assert_eq!(values.as_object().unwrap().len(), 1 + 22 + 2 + 20);
+    // r[j] = I[j] = -1, "at the tip"), c[j], the 20 chart coefficients and
+    // chart_source = 2 (parameters: the FMU uses this chart).
+    assert_eq!(values.as_object().unwrap().len(), 1 + 22 + 2 + 20 + 1);
+    assert_eq!(values["chart_source"], 2);
     assert_eq!(values["r[1]"], -1.0);
     assert_eq!(values["I[2]"], -1.0);
     assert_eq!(values["gr[1]"], 1.0);

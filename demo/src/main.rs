@@ -7,28 +7,36 @@
 //! master (controller, then plant, every sample period). By default the FMUs
 //! are (re)built first with `fmu-build`. Prints the summary and writes CSV and
 //! the paper-style plots under `target/demo/`.
+//!
+//! `--model FILE` puts a robot parameter file (`robots/`) into both FMUs: the
+//! controller computes that robot's eigenmode family itself (its default
+//! `chart_source = computed`). `--links 3` runs the 3-link pair
+//! `EigenMPC3.fmu` / `TriplePendulum.fmu`.
 
 use anyhow::{Context, Result, anyhow, bail};
 use clap::Parser;
-use eigenmpc::mechanics::{DoublePendulum, PlanarChainParams};
+use eigenmpc::mechanics::{PlanarChain, PlanarChainParams, Vector};
+use eigenmpc::model_file::RobotFile;
 use eigenmpc::modes::Family;
 use eigenmpc::mpc::ControlStatus;
 use eigenmpc::mpc::closed_loop::{Sample, mode_and_chart, summarise};
 use eigenmpc_cli::report::{plot_run, summary_text, write_csv};
+use eigenmpc_fmu_models::controller::start_values::model_start_values;
 use fmi::fmi2::Fmi2Res;
 use fmi::fmi2::import::Fmi2Import;
 use fmi::fmi2::instance::{CoSimulation, Common, InstanceCS};
 use fmi::traits::FmiImport;
-use nalgebra::{SVector, Vector2};
+use fmi2_slave::Value;
+use nalgebra::SVector;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
-/// Co-simulation demo of the two FMUs.
+/// Co-simulation demo of the controller and plant FMUs.
 #[derive(Parser, Debug)]
 #[command(name = "eigenmpc-demo", version, about)]
 struct Args {
-    /// Directory holding EigenMPC.fmu and DoublePendulum.fmu.
+    /// Directory holding EigenMPC.fmu and DoublePendulum.fmu (and the 3-link pair).
     #[arg(long, default_value = "target/fmu")]
     fmu_dir: PathBuf,
     /// Output directory for the CSV and the plots.
@@ -37,16 +45,27 @@ struct Args {
     /// Use the .fmu files as they are instead of rebuilding them first.
     #[arg(long)]
     no_build: bool,
-    /// Reference energy E_ref (J); the in-phase chart at this energy is
-    /// computed and passed to the controller FMU.
+    /// Reference energy E_ref (J); the controller FMU computes the chart.
     #[arg(long, default_value_t = 14.0)]
     energy: f64,
-    /// Simulated time (s).
-    #[arg(long, default_value_t = 30.0)]
-    duration: f64,
-    /// Initial joint angles q1,q2 (rad), at rest.
-    #[arg(long, default_value = "0.05,0.05", allow_hyphen_values = true)]
-    q0: String,
+    /// Simulated time (s; default 30 for 2 links, 60 for 3).
+    #[arg(long)]
+    duration: Option<f64>,
+    /// Initial joint angles q1,q2[,q3] (rad), at rest (default 0.05 each).
+    #[arg(long, allow_hyphen_values = true)]
+    q0: Option<String>,
+    /// Number of links: 2 (EigenMPC.fmu, DoublePendulum.fmu) or 3
+    /// (EigenMPC3.fmu, TriplePendulum.fmu); default 2, or the model file's.
+    #[arg(long)]
+    links: Option<usize>,
+    /// Robot parameter file (JSON or YAML, see robots/README.md) for the
+    /// controller's model and the plant; default: the paper's point masses.
+    #[arg(long)]
+    model: Option<PathBuf>,
+    /// Torque bound |tau_j| <= tau_max (N m; default 1, or less where the
+    /// model file's motor limits tl<j> are lower).
+    #[arg(long)]
+    tau_max: Option<f64>,
 }
 
 /// One loaded FMU instance and its value references by name.
@@ -141,83 +160,154 @@ fn main() -> std::process::ExitCode {
 }
 
 fn run(args: &Args) -> Result<()> {
-    let q0: Vec<f64> = args
-        .q0
-        .split(',')
-        .map(|s| s.trim().parse::<f64>())
-        .collect::<Result<_, _>>()
-        .context("--q0 needs two numbers q1,q2")?;
-    if q0.len() != 2 || q0.iter().any(|v| !v.is_finite()) {
-        bail!("--q0 needs two finite numbers q1,q2");
+    let file = args.model.as_ref().map(RobotFile::load).transpose()?;
+    let links = match (args.links, &file) {
+        (Some(n), Some(f)) if n != f.links() => bail!(
+            "--links {n} but {} describes {} links",
+            f.path().display(),
+            f.links()
+        ),
+        (Some(n), _) => n,
+        (None, Some(f)) => f.links(),
+        (None, None) => 2,
+    };
+    match links {
+        2 => co_simulate::<2, 4>(args, file.as_ref(), ("EigenMPC", "DoublePendulum")),
+        3 => co_simulate::<3, 6>(args, file.as_ref(), ("EigenMPC3", "TriplePendulum")),
+        n => bail!("--links {n}: the FMUs are built for 2 or 3 links"),
     }
-    if !(args.duration > 0.0 && args.duration <= 3600.0) {
+}
+
+/// Sets every Real start value of `values` (the model rows are all Real).
+fn set_values(slave: &mut Slave, values: &[(String, Value)]) -> Result<()> {
+    for (name, value) in values {
+        let Value::Real(v) = value else {
+            bail!("{name}: a model parameter that is not Real");
+        };
+        let vr = slave.vr(name)?;
+        slave.set(&[vr], &[*v])?;
+    }
+    Ok(())
+}
+
+fn co_simulate<const N: usize, const NX: usize>(
+    args: &Args,
+    file: Option<&RobotFile>,
+    (controller_name, plant_name): (&'static str, &'static str),
+) -> Result<()> {
+    let q0: Vec<f64> = match &args.q0 {
+        Some(text) => text
+            .split(',')
+            .map(|s| s.trim().parse::<f64>())
+            .collect::<Result<_, _>>()
+            .with_context(|| format!("--q0 needs {N} numbers"))?,
+        None => vec![0.05; N],
+    };
+    if q0.len() != N || q0.iter().any(|v| !v.is_finite()) {
+        bail!("--q0 needs {N} finite numbers (one angle per joint)");
+    }
+    let duration = args.duration.unwrap_or(if N == 2 { 30.0 } else { 60.0 });
+    if !(duration > 0.0 && duration <= 3600.0) {
         bail!("--duration must be in (0, 3600] s");
     }
+    if !(args.energy.is_finite() && args.energy > 0.0) {
+        bail!("--energy must be finite and > 0");
+    }
+    let params: PlanarChainParams<N> = match file {
+        Some(f) => f.params::<N>()?,
+        None => PlanarChainParams::default(),
+    };
+    let model = PlanarChain::new(params)?;
+    let limit = file
+        .and_then(|f| f.torque_limits())
+        .map(|tl| tl.into_iter().fold(f64::INFINITY, f64::min));
+    let tau_max = match (args.tau_max, limit) {
+        (Some(t), Some(tl)) if t > tl => {
+            bail!("--tau-max {t} exceeds the robot's motor torque limit {tl} N m")
+        }
+        (Some(t), _) => t,
+        (None, tl) => tl.unwrap_or(1.0).min(1.0),
+    };
     if !args.no_build {
         build_fmus()?;
     }
-    let model = DoublePendulum::new(PlanarChainParams::default())?;
-    // The true eigenmode (for the plot overlay and the distance metric) and
-    // the chart the curved controller needs at this energy.
-    let (mode, chart) = mode_and_chart::<_, 2, 4>(&model, Family::InPhase.index(), args.energy, 9)
+    // The true eigenmode, for the plot overlay and the distance metric (the
+    // controller FMU computes its own chart family).
+    let (mode, _) = mode_and_chart::<_, N, NX>(&model, Family::InPhase.index(), args.energy, 9)
         .with_context(|| format!("in-phase eigenmode at {} J", args.energy))?;
+    let model_values = model_start_values(&params).map_err(|e| anyhow!("model: {e}"))?;
 
-    let mut controller = Slave::load(&args.fmu_dir.join("EigenMPC.fmu"), "EigenMPC")?;
-    let mut plant = Slave::load(&args.fmu_dir.join("DoublePendulum.fmu"), "DoublePendulum")?;
+    let mut controller = Slave::load(
+        &args.fmu_dir.join(format!("{controller_name}.fmu")),
+        controller_name,
+    )?;
+    let mut plant = Slave::load(&args.fmu_dir.join(format!("{plant_name}.fmu")), plant_name)?;
 
-    let plant_out = plant.vrs(&["q[1]", "q[2]", "qd[1]", "qd[2]", "energy"])?;
-    let plant_in = plant.vrs(&["tau[1]", "tau[2]"])?;
-    let ctrl_in = controller.vrs(&["q[1]", "q[2]", "qd[1]", "qd[2]"])?;
-    let ctrl_out = controller.vrs(&["tau[1]", "tau[2]", "solve_time"])?;
+    let joints = |base: &'static str| (1..=N).map(move |j| format!("{base}[{j}]"));
+    let state_names: Vec<String> = joints("q").chain(joints("qd")).collect();
+    let state_names: Vec<&str> = state_names.iter().map(String::as_str).collect();
+    let tau_names: Vec<String> = joints("tau").collect();
+    let tau_names: Vec<&str> = tau_names.iter().map(String::as_str).collect();
+    let q0_names: Vec<String> = joints("q0").collect();
+    let q0_names: Vec<&str> = q0_names.iter().map(String::as_str).collect();
+    let plant_out = plant.vrs(&[state_names.as_slice(), &["energy"]].concat())?;
+    let plant_in = plant.vrs(&tau_names)?;
+    let ctrl_in = controller.vrs(&state_names)?;
+    let ctrl_out = controller.vrs(&[tau_names.as_slice(), &["solve_time"]].concat())?;
     let ctrl_diag = controller.vrs(&["solver_status", "qp_iterations"])?;
 
     // No stop time: the controller also steps at the last sample to report its torque.
     plant.initialize(0.0, None)?;
-    plant.set(&plant.vrs(&["q0[1]", "q0[2]"])?, &q0)?;
+    set_values(&mut plant, &model_values)?;
+    plant.set(&plant.vrs(&q0_names)?, &q0)?;
     plant.exit_initialization()?;
 
     controller.initialize(0.0, None)?;
-    controller.set(&[controller.vr("E_ref")?], &[args.energy])?;
-    for j in 0..2 {
-        for (k, a) in chart.coefficients[j].iter().enumerate() {
-            let vr = controller.vr(&format!("chart.coef[{},{k}]", j + 1))?;
-            controller.set(&[vr], &[*a])?;
-        }
-    }
+    set_values(&mut controller, &model_values)?;
+    let reference = controller.vrs(&["E_ref", "tau_max"])?;
+    controller.set(&reference, &[args.energy, tau_max])?;
     let mut dt = [0.0];
     controller.get(&[controller.vr("sample_period")?], &mut dt)?;
     let h = dt[0];
-    // Inputs for the first solve, done at exitInitializationMode.
-    let mut y = [0.0; 5];
+    // Inputs for the first solve, done at exitInitializationMode (where the
+    // controller computes its chart family).
+    let mut y = vec![0.0; 2 * N + 1];
     plant.get(&plant_out, &mut y)?;
-    controller.set(&ctrl_in, &y[..4])?;
+    controller.set(&ctrl_in, &y[..2 * N])?;
+    let created = Instant::now();
     controller.exit_initialization()?;
+    let created = created.elapsed().as_secs_f64();
+    let mut range = [0.0; 2];
+    controller.get(
+        &controller.vrs(&["chart_energy_min", "chart_energy_max"])?,
+        &mut range,
+    )?;
 
-    let steps = (args.duration / h).round() as usize;
-    let mut trace = Vec::with_capacity(steps + 1);
+    let steps = (duration / h).round() as usize;
+    let mut trace: Vec<Sample<N, NX>> = Vec::with_capacity(steps + 1);
+    let mut out = vec![0.0; N + 1];
     let wall = Instant::now();
     for k in 0..=steps {
         let t = k as f64 * h;
         plant.get(&plant_out, &mut y)?;
         if k > 0 {
             // At t_start the inputs were set during initialization (first solve).
-            controller.set(&ctrl_in, &y[..4])?;
+            controller.set(&ctrl_in, &y[..2 * N])?;
         }
         // The controller solves at the communication point t with the inputs
         // just set; its torque is the output when doStep returns, held over
         // [t, t + h] (see README, "Timing").
         controller.step(t, h)?;
-        let mut out = [0.0; 3];
         controller.get(&ctrl_out, &mut out)?;
         let mut diag = [0; 2];
         let r = controller.instance.get_integer(&ctrl_diag, &mut diag);
         controller.check("fmi2GetInteger", r)?;
         trace.push(Sample {
             time: t,
-            state: SVector::<f64, 4>::from_column_slice(&y[..4]),
-            tau: Vector2::new(out[0], out[1]),
-            energy: y[4],
-            solve_time: out[2],
+            state: SVector::<f64, NX>::from_column_slice(&y[..2 * N]),
+            tau: Vector::<N>::from_column_slice(&out[..N]),
+            energy: y[2 * N],
+            solve_time: out[N],
             preparation_time: 0.0,
             status: ControlStatus::from_code(diag[0])
                 .ok_or_else(|| anyhow!("unknown solver_status {}", diag[0]))?,
@@ -226,15 +316,28 @@ fn run(args: &Args) -> Result<()> {
         if k == steps {
             break;
         }
-        plant.set(&plant_in, &out[..2])?;
+        plant.set(&plant_in, &out[..N])?;
         plant.step(t, h)?;
     }
     let wall = wall.elapsed().as_secs_f64();
 
     let summary = summarise(&trace, args.energy, Some(&mode.path), 5.0);
+    let robot = match file {
+        Some(f) => format!("{} ({})", f.name().unwrap_or("robot"), f.path().display()),
+        None => format!("{N}-link point-mass chain (1 kg, 1 m)"),
+    };
+    let q0_text: Vec<String> = q0.iter().map(|q| q.to_string()).collect();
     println!(
-        "EigenMPC.fmu drives DoublePendulum.fmu: curved, in-phase, E_ref = {} J, q0 = ({}, {}), {} s, sample period {} s",
-        args.energy, q0[0], q0[1], args.duration, h
+        "{controller_name}.fmu drives {plant_name}.fmu: {robot}, curved, in-phase, E_ref = {} J, \
+         |tau| <= {tau_max} N m, q0 = ({}), {duration} s, sample period {h} s",
+        args.energy,
+        q0_text.join(", ")
+    );
+    println!(
+        "chart family computed by the controller FMU: {:.4} .. {:.4} J in {:.0} ms",
+        range[0],
+        range[1],
+        created * 1e3
     );
     print!("{}", summary_text(&summary));
     println!("co-simulation wall time:         {wall:.2} s");

@@ -270,3 +270,33 @@ fn start_values_of_the_default_model_are_the_fmu_defaults() {
     .unwrap_err();
     assert!(e.contains("E_ref = -1 is below its minimum"), "{e}");
 }
+
+/// The model start values name variables of both the controller and the
+/// plant FMU (the demo sets one list on both), with the values of the model.
+#[test]
+fn model_start_values_fit_controller_and_plant() {
+    use eigenmpc::mechanics::{Joint, PlanarChainParams};
+    use eigenmpc_fmu_models::controller::start_values::model_start_values;
+    let mut p = PlanarChainParams::<2>::point_masses([0.6, 0.5], [0.3, 0.2], 9.81);
+    p.joints[1] = Joint {
+        viscous: 0.01,
+        coulomb: 0.08,
+        ..Joint::default()
+    };
+    let values = model_start_values(&p).unwrap();
+    assert_eq!(values.len(), 22);
+    let controller = EigenMpcFmu::description();
+    let plant = DoublePendulumFmu::description();
+    for (name, _) in &values {
+        assert!(controller.variable(name).is_some(), "controller: {name}");
+        assert!(plant.variable(name).is_some(), "plant: {name}");
+    }
+    let get = |n: &str| values.iter().find(|(name, _)| name == n).unwrap().1;
+    assert_eq!(get("m[1]"), Value::Real(0.6));
+    assert_eq!(get("cf[2]"), Value::Real(0.08));
+    assert_eq!(get("b[2]"), Value::Real(0.01));
+    let mut bad = p;
+    bad.links[0].mass = -1.0;
+    let e = model_start_values(&bad).unwrap_err();
+    assert!(e.contains("m[1]"), "{e}");
+}

@@ -29,8 +29,9 @@ pub struct ModesArgs {
     #[arg(long, default_value_t = 200)]
     samples: usize,
     /// Also write the controller FMU's start values (model, eigenvector,
-    /// `E_ref`, chart coefficients) for the single requested energy to FILE,
-    /// as a JSON object `{"variable name": value}` (e.g. for fmpy's
+    /// `E_ref`, chart coefficients, `chart_source = parameters` so that the
+    /// FMU uses this chart) for the single requested energy to FILE, as a
+    /// JSON object `{"variable name": value}` (e.g. for fmpy's
     /// `simulate_fmu(..., start_values=json.load(f))`).
     #[arg(long, value_name = "FILE")]
     fmu_start_values: Option<std::path::PathBuf>,

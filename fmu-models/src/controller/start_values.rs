@@ -9,6 +9,42 @@ use eigenmpc::mechanics::PlanarChainParams;
 use eigenmpc::mpc::Variant;
 use fmi2_slave::Value;
 
+/// The start values (name, value) of the model parameters of `model`, in
+/// table order (`m[j]`, `l[j]`, `g`, `r[j]`, `I[j]`, ...): what makes the
+/// controller FMU's model (and, same names, the plant FMU) that robot.
+/// Refused (the message names the variable): a model the FMU cannot
+/// express, a value outside its variable's range.
+pub fn model_start_values<const N: usize>(
+    model: &PlanarChainParams<N>,
+) -> Result<Vec<(String, Value)>, String> {
+    let mut settings = Settings::<N>::paper(
+        Variant::Curved,
+        1.0,
+        [1.0; N],
+        [[0.0; CHART_COEFFICIENTS]; N],
+    );
+    settings.model = ChainParameters::from_params(model)?;
+    settings.system()?;
+    checked(&settings, |r| r.group == Some(MODEL_GROUP))
+}
+
+/// The start values of the rows `select` picks, each checked against its
+/// variable's range.
+fn checked<const N: usize>(
+    settings: &Settings<N>,
+    select: impl Fn(&fmi2_slave::table::Row<Settings<N>>) -> bool,
+) -> Result<Vec<(String, Value)>, String> {
+    let t = table::<N>();
+    let values = t.start_values(settings, select);
+    let variables = t.variables(settings);
+    for (name, value) in &values {
+        if let Some(v) = variables.iter().find(|v| &v.name == name) {
+            v.check_value(*value)?;
+        }
+    }
+    Ok(values)
+}
+
 /// The start values (name, value), in table order, that make the `N`-joint
 /// controller FMU control `model` at `e_ref` along the chart
 /// `X_j(s) = sum_k chart[j][k] s^k` in `s = c'q` with the unit eigenvector
@@ -49,15 +85,7 @@ pub fn start_values<const N: usize>(
     }
     let system = settings.system()?;
     settings.reference(&system)?;
-    let t = table::<N>();
-    let values = t.start_values(&settings, |r| {
+    checked(&settings, |r| {
         matches!(r.group, Some(MODEL_GROUP) | Some(REFERENCE_GROUP))
-    });
-    let variables = t.variables(&settings);
-    for (name, value) in &values {
-        if let Some(v) = variables.iter().find(|v| &v.name == name) {
-            v.check_value(*value)?;
-        }
-    }
-    Ok(values)
+    })
 }
