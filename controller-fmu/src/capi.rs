@@ -11,19 +11,25 @@
 //! eigenmpc_free(mpc);
 //! ```
 //!
+//! Any robot, 2 or 3 joints: `eigenmpc_create_named` takes the controller
+//! FMU's parameter names and values (`m[1]`, `r[1]`, `I[1]`, `cf[2]`,
+//! `E_ref`, `chart_source`, ...; every rigid-link parameter), checked and
+//! defaulted by the FMU's own variable table.
+//!
 //! Every function checks its pointers and catches panics: a failure is a
 //! return value (NULL, a negative status) and a message, never an abort.
 //! A handle may be used from any thread, one call at a time.
 
-use crate::{PendulumController, STATUS_BAD_ARGUMENT};
-use eigenmpc::mpc::{ControlOutput, ControlStatus, Variant};
+use crate::STATUS_BAD_ARGUMENT;
+use eigenmpc::mpc::{ControlStatus, CostParams, Variant};
 use eigenmpc_fmu_models::chain::ChainParameters;
 use eigenmpc_fmu_models::controller::ControllerProduct;
-use eigenmpc_fmu_models::controller::settings::{ChartSource, Settings, Tuning};
+use eigenmpc_fmu_models::controller::named::settings_from_named;
+use eigenmpc_fmu_models::controller::settings::{ChainController, ChartSource, Settings, Tuning};
 use eigenmpc_fmu_models::enums::{CHART_SOURCE, QP_SOLVER, VARIANT};
-use eigenmpc_fmu_models::products::EigenMpc2;
+use eigenmpc_fmu_models::products::{EigenMpc2, EigenMpc3};
 use nalgebra::SVector;
-use std::ffi::{CString, c_char};
+use std::ffi::{CStr, CString, c_char};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
 /// Number of chart coefficients per joint in [`eigenmpc_create`]'s
@@ -95,10 +101,56 @@ pub struct EigenMpcStepInfo {
     pub energy: f64,
 }
 
-/// An EigenMPC controller (opaque). Create with [`eigenmpc_create`], free
-/// with [`eigenmpc_free`].
+/// The controller behind a handle, whatever its number of joints.
+trait JointController: Send {
+    fn joints(&self) -> usize;
+    /// One sample; `state` has `2 joints`, `tau` `joints` elements.
+    fn step(&mut self, state: &[f64], tau: &mut [f64]) -> EigenMpcStepInfo;
+    fn set_cost(&mut self, cost: CostParams) -> Result<(), String>;
+    fn set_e_ref(&mut self, e_ref: f64) -> Result<(), String>;
+    fn reset(&mut self);
+}
+
+impl<const N: usize, const NX: usize> JointController for ChainController<N, NX> {
+    fn joints(&self) -> usize {
+        N
+    }
+
+    fn step(&mut self, state: &[f64], tau: &mut [f64]) -> EigenMpcStepInfo {
+        let z = SVector::<f64, NX>::from_column_slice(state);
+        let out = self.step(&z);
+        tau.copy_from_slice(out.tau.as_slice());
+        let energy = if matches!(out.status, ControlStatus::InvalidState) {
+            f64::NAN
+        } else {
+            self.energy(&z)
+        };
+        EigenMpcStepInfo {
+            status: out.status.code(),
+            qp_iterations: u32::try_from(out.qp_iterations).unwrap_or(u32::MAX),
+            solve_time: out.preparation_time + out.feedback_time,
+            energy,
+        }
+    }
+
+    fn set_cost(&mut self, cost: CostParams) -> Result<(), String> {
+        ChainController::set_cost(self, cost).map_err(|e| e.to_string())
+    }
+
+    fn set_e_ref(&mut self, e_ref: f64) -> Result<(), String> {
+        ChainController::set_e_ref(self, e_ref).map_err(|e| e.to_string())
+    }
+
+    fn reset(&mut self) {
+        ChainController::reset(self);
+    }
+}
+
+/// An EigenMPC controller (opaque). Create with [`eigenmpc_create`] (the
+/// paper's double pendulum, point masses) or [`eigenmpc_create_named`] (any
+/// robot, 2 or 3 joints), free with [`eigenmpc_free`].
 pub struct EigenMpc {
-    controller: PendulumController,
+    controller: Box<dyn JointController>,
     variant: Variant,
     info: EigenMpcStepInfo,
     /// Message of the last failed call ("" if none), NUL-terminated.
@@ -234,22 +286,110 @@ pub unsafe extern "C" fn eigenmpc_create(
                 row.copy_from_slice(&coef[j * CHART_COEFFICIENTS..(j + 1) * CHART_COEFFICIENTS]);
             }
         }
-        let controller = settings.build::<4>()?;
-        Ok(EigenMpc {
-            controller,
-            variant: settings.variant,
-            info: EigenMpcStepInfo::default(),
-            last_error: CString::default(),
-        })
+        handle::<2, 4>(&settings)
     }));
+    // SAFETY: the caller's guarantee on `error`.
+    unsafe { finish_create("eigenmpc_create", result, error, error_len) }
+}
+
+/// A handle for the controller `settings` define.
+fn handle<const N: usize, const NX: usize>(settings: &Settings<N>) -> Result<EigenMpc, String> {
+    let controller: Box<dyn JointController> = Box::new(settings.build::<NX>()?);
+    Ok(EigenMpc {
+        controller,
+        variant: settings.variant,
+        info: EigenMpcStepInfo::default(),
+        last_error: CString::default(),
+    })
+}
+
+/// The handle, or NULL and the message in `error`.
+///
+/// # Safety
+/// `error` is NULL or valid for `error_len` bytes.
+unsafe fn finish_create(
+    function: &str,
+    result: std::thread::Result<Result<EigenMpc, String>>,
+    error: *mut c_char,
+    error_len: usize,
+) -> *mut EigenMpc {
     let message = match result {
         Ok(Ok(mpc)) => return Box::into_raw(Box::new(mpc)),
-        Ok(Err(message)) => format!("eigenmpc_create: {message}"),
-        Err(_) => "eigenmpc_create: internal error (panic caught)".to_string(),
+        Ok(Err(message)) => format!("{function}: {message}"),
+        Err(_) => format!("{function}: internal error (panic caught)"),
     };
     // SAFETY: the caller's guarantee on `error`.
     unsafe { write_error(error, error_len, &message) };
     std::ptr::null_mut()
+}
+
+/// Creates a controller for `joints` = 2 (the `EigenMPC` FMU's parameters)
+/// or 3 (`EigenMPC3`'s) from parameter names and values: `count` pairs
+/// `names[i]` = `values[i]`, any parameter of that FMU's variable table
+/// (README, "FMI 2.0 co-simulation FMUs"): the model (`m[j]`, `l[j]`, `g`,
+/// `r[j]`, `I[j]`, `Ir[j]`, `gr[j]`, `b[j]`, `cf[j]`, `k[j]`, `q_rest[j]`,
+/// `coulomb_sharpness`), the tuning (`E_ref`, `w_E`, ...), `variant`,
+/// `qp_solver`, `horizon`, `chart_source`, `mode`, `c[j]`,
+/// `chart.coef[j,k]`, ... (integer and enumeration parameters as integral
+/// doubles). What is not named keeps the FMU's default; the names and values
+/// of `eigenmpc modes --fmu-start-values` work as they are. Each value is
+/// checked as the FMU checks it. On failure returns NULL and writes the
+/// reason (naming the parameter) into `error` as [`eigenmpc_create`] does.
+/// With the default `chart_source` (computed) the mode family is computed
+/// here (tens of milliseconds).
+///
+/// # Safety
+/// `names` is NULL or points to `count` NUL-terminated strings, `values` is
+/// NULL or points to `count` doubles (both may be NULL when `count` is 0);
+/// `error` is NULL or valid for `error_len` bytes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn eigenmpc_create_named(
+    joints: u32,
+    names: *const *const c_char,
+    values: *const f64,
+    count: usize,
+    error: *mut c_char,
+    error_len: usize,
+) -> *mut EigenMpc {
+    let result = catch_unwind(AssertUnwindSafe(|| -> Result<EigenMpc, String> {
+        if count > 0 && (names.is_null() || values.is_null()) {
+            return Err("names or values is NULL".into());
+        }
+        let mut pairs = Vec::with_capacity(count);
+        for i in 0..count {
+            // SAFETY: the caller guarantees `count` names and values.
+            let (name, value) = unsafe { (*names.add(i), *values.add(i)) };
+            if name.is_null() {
+                return Err(format!("names[{i}] is NULL"));
+            }
+            // SAFETY: non-null, NUL-terminated (caller's guarantee).
+            let name = unsafe { CStr::from_ptr(name) }
+                .to_str()
+                .map_err(|_| format!("names[{i}] is not UTF-8"))?;
+            pairs.push((name, value));
+        }
+        match joints {
+            2 => handle::<2, 4>(&settings_from_named::<EigenMpc2, 2>(&pairs)?),
+            3 => handle::<3, 6>(&settings_from_named::<EigenMpc3, 3>(&pairs)?),
+            n => Err(format!("joints = {n}: 2 or 3 are available")),
+        }
+    }));
+    // SAFETY: the caller's guarantee on `error`.
+    unsafe { finish_create("eigenmpc_create_named", result, error, error_len) }
+}
+
+/// Number of joints of the handle's controller (2 or 3), or
+/// `EIGENMPC_STATUS_BAD_ARGUMENT` for a NULL handle.
+///
+/// # Safety
+/// `mpc` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn eigenmpc_joints(mpc: *const EigenMpc) -> i32 {
+    if mpc.is_null() {
+        return STATUS_BAD_ARGUMENT;
+    }
+    // SAFETY: non-null live handle; joints() cannot panic.
+    unsafe { (*mpc).controller.joints() as i32 }
 }
 
 /// Runs `body` on the handle under `catch_unwind`; NULL handle or panic:
@@ -311,17 +451,18 @@ pub unsafe extern "C" fn eigenmpc_set_tuning(
     }
 }
 
-/// One control sample: measured `state` = (q1, q2, qd1, qd2) in rad, rad/s;
-/// writes the torque to apply until the next sample to `tau_out` (N m,
-/// always finite and within +-tau_max). Returns the status:
+/// One control sample: measured `state` = (q1, .., qn, qd1, .., qdn) in rad,
+/// rad/s, n = [`eigenmpc_joints`] (2 from [`eigenmpc_create`]); writes the
+/// n torques to apply until the next sample to `tau_out` (N m, always
+/// finite and within +-tau_max). Returns the status:
 /// `EIGENMPC_STATUS_SOLVED` (0), `_NOT_CONVERGED` (1, first sample only),
 /// `_QP_FAILED` (2) or `_INVALID_STATE` (3) (both with the fallback torque),
 /// or `_BAD_ARGUMENT` (-1: NULL pointer; `tau_out` untouched). Call it every
 /// `sample_period` seconds.
 ///
 /// # Safety
-/// `mpc` is NULL or a live handle; `state` is NULL or points to 4 doubles;
-/// `tau_out` is NULL or points to 2 writable doubles.
+/// `mpc` is NULL or a live handle; `state` is NULL or points to 2 n
+/// doubles; `tau_out` is NULL or points to n writable doubles.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn eigenmpc_step(
     mpc: *mut EigenMpc,
@@ -334,21 +475,10 @@ pub unsafe extern "C" fn eigenmpc_step(
             if state.is_null() || tau_out.is_null() {
                 return h.fail("eigenmpc_step: state or tau_out is NULL".into());
             }
-            let z = SVector::<f64, 4>::from_column_slice(std::slice::from_raw_parts(state, 4));
-            let out: ControlOutput<2> = h.controller.step(&z);
-            *tau_out = out.tau[0];
-            *tau_out.add(1) = out.tau[1];
-            let energy = if matches!(out.status, ControlStatus::InvalidState) {
-                f64::NAN
-            } else {
-                h.controller.energy(&z)
-            };
-            h.info = EigenMpcStepInfo {
-                status: out.status.code(),
-                qp_iterations: u32::try_from(out.qp_iterations).unwrap_or(u32::MAX),
-                solve_time: out.preparation_time + out.feedback_time,
-                energy,
-            };
+            let n = h.controller.joints();
+            let z = std::slice::from_raw_parts(state, 2 * n);
+            let tau = std::slice::from_raw_parts_mut(tau_out, n);
+            h.info = h.controller.step(z, tau);
             h.info.status
         })
     }

@@ -602,6 +602,113 @@ fn c_api_steps_like_the_controller() {
     }
 }
 
+/// `eigenmpc_create_named`: FMU parameter names for 2 and 3 joints; the
+/// 3-joint handle steps exactly like the `EigenMPC3` FMU's controller, and
+/// a rigid-link model with friction given by name is the controller's model.
+#[test]
+fn c_api_creates_any_robot_from_parameter_names() {
+    use eigenmpc_fmu_models::products::EigenMpc3;
+    use std::ffi::CString;
+    let named = |joints: u32, pairs: &[(&str, f64)]| -> (*mut EigenMpc, String) {
+        let names: Vec<CString> = pairs.iter().map(|p| CString::new(p.0).unwrap()).collect();
+        let pointers: Vec<*const std::ffi::c_char> = names.iter().map(|n| n.as_ptr()).collect();
+        let values: Vec<f64> = pairs.iter().map(|p| p.1).collect();
+        let mut err = [0 as std::ffi::c_char; 300];
+        let mpc = unsafe {
+            eigenmpc_create_named(
+                joints,
+                pointers.as_ptr(),
+                values.as_ptr(),
+                pairs.len(),
+                err.as_mut_ptr(),
+                err.len(),
+            )
+        };
+        let text = unsafe { CStr::from_ptr(err.as_ptr()) };
+        (mpc, text.to_str().unwrap().to_string())
+    };
+    // 3 joints, defaults: the EigenMPC3 FMU's controller, sample for sample.
+    let (mpc, _) = named(3, &[]);
+    assert!(!mpc.is_null());
+    assert_eq!(unsafe { eigenmpc_joints(mpc) }, 3);
+    let mut native = EigenMpc3::settings(Variant::Curved).build::<6>().unwrap();
+    let mut z = SVector::<f64, 6>::new(0.05, 0.05, 0.05, 0.0, 0.0, 0.0);
+    for _ in 0..20 {
+        let mut tau = [f64::NAN; 3];
+        assert_eq!(
+            unsafe { eigenmpc_step(mpc, z.as_ptr(), tau.as_mut_ptr()) },
+            0
+        );
+        let expected = native.step(&z).tau;
+        assert_eq!(tau.as_slice(), expected.as_slice());
+        z = z.map(|v| v * 1.01) + SVector::<f64, 6>::repeat(1e-3);
+    }
+    unsafe { eigenmpc_free(mpc) };
+
+    // 2 joints, a rigid-link robot with friction, by name.
+    let robot = [
+        ("m[1]", 0.6),
+        ("m[2]", 0.6),
+        ("l[1]", 0.3),
+        ("l[2]", 0.2),
+        ("r[1]", 0.3),
+        ("r[2]", 0.2),
+        ("I[1]", 0.06),
+        ("I[2]", 0.025),
+        ("b[1]", 0.001),
+        ("cf[2]", 0.09),
+        ("E_ref", 1.0),
+        ("tau_max", 0.5),
+    ];
+    let (mpc, err) = named(2, &robot);
+    assert!(!mpc.is_null(), "{err}");
+    let mut settings = EigenMpc2::settings(Variant::Curved);
+    settings.model.mass = [0.6, 0.6];
+    settings.model.length = [0.3, 0.2];
+    settings.model.com = [0.3, 0.2];
+    settings.model.inertia = [0.06, 0.025];
+    settings.model.joints[0].viscous = 0.001;
+    settings.model.joints[1].coulomb = 0.09;
+    settings.tuning.e_ref = 1.0;
+    settings.tau_max = 0.5;
+    let mut native = settings.build::<4>().unwrap();
+    assert!(native.system().params().has_friction());
+    let z = SVector::<f64, 4>::new(0.05, 0.05, 0.0, 0.0);
+    let mut tau = [f64::NAN; 2];
+    let expected = native.step(&z);
+    assert_eq!(
+        unsafe { eigenmpc_step(mpc, z.as_ptr(), tau.as_mut_ptr()) },
+        expected.status.code()
+    );
+    assert_eq!(tau.as_slice(), expected.tau.as_slice());
+    let mut info = EigenMpcStepInfo::default();
+    assert_eq!(unsafe { eigenmpc_last_step(mpc, &mut info) }, 0);
+    assert!((info.energy - native.energy(&z)).abs() < 1e-15);
+    unsafe { eigenmpc_free(mpc) };
+
+    // refused with the FMU's messages
+    for (joints, pairs, needle) in [
+        (2, vec![("m[3]", 1.0)], "m[3] is not a variable of EigenMPC"),
+        (3, vec![("q[1]", 0.1)], "q[1] is not a parameter"),
+        (2, vec![("cf[1]", -1.0)], "cf[1] = -1 is below its minimum"),
+        (2, vec![("mode", 1.5)], "mode = 1.5 must be an integer"),
+        (4, vec![], "joints = 4"),
+    ] {
+        let (mpc, err) = named(joints, &pairs);
+        assert!(mpc.is_null());
+        assert!(
+            err.starts_with("eigenmpc_create_named: ") && err.contains(needle),
+            "{err}"
+        );
+    }
+    unsafe {
+        let mut err = [0 as std::ffi::c_char; 100];
+        let mpc = eigenmpc_create_named(2, ptr::null(), ptr::null(), 1, err.as_mut_ptr(), 100);
+        assert!(mpc.is_null());
+        assert_eq!(eigenmpc_joints(ptr::null()), -1);
+    }
+}
+
 /// The controller's cdylib built for this test run.
 fn library() -> PathBuf {
     fmi2_slave::testing::test_cdylib("eigenmpc_fmu")
@@ -613,6 +720,8 @@ fn shared_library_exports_all_34_functions_and_the_c_api() {
     for name in [
         "eigenmpc_config_default",
         "eigenmpc_create",
+        "eigenmpc_create_named",
+        "eigenmpc_joints",
         "eigenmpc_set_e_ref",
         "eigenmpc_set_tuning",
         "eigenmpc_step",

@@ -130,6 +130,22 @@ int main(void) {
 
     eigenmpc_free(mpc);
     eigenmpc_free(NULL);
+
+    /* Any robot by the FMU's parameter names: a 3-link chain with a lighter
+     * last link and Coulomb friction at joint 2, straight variant. */
+    const char *names[] = {"m[3]", "cf[2]", "variant", "E_ref", "tau_max"};
+    const double values[] = {0.5, 0.05, EIGENMPC_VARIANT_STRAIGHT, 6.0, 2.0};
+    mpc = eigenmpc_create_named(3, names, values, 5, err, sizeof err);
+    CHECK(mpc != NULL);
+    CHECK(eigenmpc_joints(mpc) == 3);
+    double z3[6] = {0.05, 0.05, 0.05, 0.0, 0.0, 0.0}, tau3[3] = {NAN, NAN, NAN};
+    CHECK(eigenmpc_step(mpc, z3, tau3) == EIGENMPC_STATUS_SOLVED);
+    for (int j = 0; j < 3; j++) CHECK(isfinite(tau3[j]) && fabs(tau3[j]) <= 2.0);
+    eigenmpc_free(mpc);
+    const char *bad[] = {"mu[1]"};
+    CHECK(eigenmpc_create_named(2, bad, values, 1, err, sizeof err) == NULL);
+    CHECK(strstr(err, "mu[1] is not a variable") != NULL);
+    printf("refused name: %s\n", err);
     printf("1 passed, 0 failed\n");
     return 0;
 }

@@ -16,6 +16,7 @@
 //! held until the next solve.
 
 pub mod docs;
+pub mod named;
 pub mod settings;
 pub mod start_values;
 pub mod table;

@@ -1,0 +1,90 @@
+//! A controller defined by FMU parameter names and values (what the C API's
+//! `eigenmpc_create_named` takes, and what `eigenmpc modes
+//! --fmu-start-values` writes): the FMU's own table gives the names, the
+//! ranges and the defaults, so the C API needs no field per parameter.
+
+use super::settings::Settings;
+use super::{ControllerProduct, description, table};
+use eigenmpc::mpc::Variant;
+use fmi2_slave::Value;
+use fmi2_slave::values::Values;
+use fmi2_slave::variables::{BaseType, Causality};
+
+/// The settings of product `P` with the parameters `(name, value)` set over
+/// its defaults, each checked as `fmi2SetReal` / `fmi2SetInteger` would
+/// check it (Integer and enumeration parameters take integral values).
+/// Refused, naming the variable: an unknown name, a variable that is not a
+/// parameter, a value out of range or not integral where it must be.
+pub fn settings_from_named<P: ControllerProduct<N>, const N: usize>(
+    values: &[(&str, f64)],
+) -> Result<Settings<N>, String> {
+    let d = description::<P, N>();
+    let mut current = Values::new(&d);
+    for &(name, x) in values {
+        let v = d
+            .variable(name)
+            .ok_or_else(|| format!("{name} is not a variable of {}", P::MODEL_NAME))?;
+        if v.causality != Causality::Parameter {
+            return Err(format!(
+                "{name} is not a parameter (it is set or read while running)"
+            ));
+        }
+        let base = v.var_type.base();
+        let value = match base {
+            BaseType::Real => Value::Real(x),
+            _ if x.fract() == 0.0 && x.abs() <= i32::MAX as f64 => Value::Integer(x as i32),
+            _ => return Err(format!("{name} = {x} must be an integer")),
+        };
+        v.check_value(value)?;
+        let index = current
+            .index(base, v.value_reference)
+            .ok_or_else(|| format!("{name}: no value slot"))?;
+        current.set_at(index, value);
+    }
+    let mut settings = P::settings(Variant::Curved);
+    table::table::<N>().read(&current, &mut settings, |_| true);
+    Ok(settings)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::controller::settings::ChartSource;
+    use crate::products::{EigenMpc2, EigenMpc3};
+
+    #[test]
+    fn names_set_the_settings_and_bad_ones_are_refused() {
+        let s = settings_from_named::<EigenMpc3, 3>(&[
+            ("m[3]", 0.5),
+            ("cf[2]", 0.08),
+            ("chart_source", 2.0),
+            ("variant", 1.0),
+            ("E_ref", 3.0),
+        ])
+        .unwrap();
+        assert_eq!(s.model.mass, [1.0, 1.0, 0.5]);
+        assert_eq!(s.model.joints[1].coulomb, 0.08);
+        assert_eq!(s.chart_source, ChartSource::Parameters);
+        assert_eq!(s.variant, Variant::Straight);
+        assert_eq!(s.tuning.e_ref, 3.0);
+        let defaults = settings_from_named::<EigenMpc2, 2>(&[]).unwrap();
+        assert_eq!(defaults, EigenMpc2::settings(Variant::Curved));
+        for (pairs, needle) in [
+            (vec![("m[3]", 1.0)], "m[3] is not a variable of EigenMPC"),
+            (vec![("q[1]", 0.1)], "q[1] is not a parameter"),
+            (vec![("horizon", 2.5)], "horizon = 2.5 must be an integer"),
+            (
+                vec![("chart_source", 3.0)],
+                "chart_source = 3 is above its maximum",
+            ),
+            (
+                vec![("m[1]", f64::NAN)],
+                "m[1] = NaN is not a finite number",
+            ),
+            (vec![("tau_max", 0.0)], "tau_max = 0 is below its minimum"),
+        ] {
+            let e = settings_from_named::<EigenMpc2, 2>(&pairs).unwrap_err();
+            assert!(e.contains(needle), "{e}");
+        }
+    }
+}
