@@ -2,7 +2,7 @@
 //! KKT conditions of the clarabel QP solutions, RTI against the converged
 //! SQP, failure handling and tuning.
 
-use eigenmpc::mechanics::{DoublePendulum, Vector};
+use eigenmpc::mechanics::{DoublePendulum, MechanicalSystem, Vector};
 use eigenmpc::modes::linear_modes;
 use eigenmpc::mpc::closed_loop::mode_and_chart;
 use eigenmpc::mpc::cost::{CostParams, Reference, residuals, stage_model};
@@ -22,6 +22,25 @@ fn straight() -> Reference<2> {
 fn curved() -> Reference<2> {
     let (_, chart) = mode_and_chart::<_, 2, 4>(&DoublePendulum::default(), 0, 14.0, 9).unwrap();
     Reference::Curved(chart)
+}
+
+fn hybrid() -> Reference<2> {
+    match curved() {
+        Reference::Curved(chart) => Reference::Hybrid(chart),
+        _ => unreachable!(),
+    }
+}
+
+/// The three variants with their references; hybrid with a larger alpha
+/// than the paper's so that the blend's derivative terms matter.
+fn variants() -> [(Reference<2>, Variant, CostParams); 3] {
+    let mut hybrid_params = params(Variant::Hybrid);
+    hybrid_params.alpha = 0.3;
+    [
+        (straight(), Variant::Straight, params(Variant::Straight)),
+        (curved(), Variant::Curved, params(Variant::Curved)),
+        (hybrid(), Variant::Hybrid, hybrid_params),
+    ]
 }
 
 fn params(variant: Variant) -> CostParams {
@@ -50,8 +69,7 @@ fn residual_jacobians_match_finite_differences() {
         Z::new(0.05, 0.05, 0.0, 0.0),
     ];
     let tau = Vector::<2>::new(0.4, -0.7);
-    for (reference, variant) in [(straight(), Variant::Straight), (curved(), Variant::Curved)] {
-        let p = params(variant);
+    for (reference, variant, p) in variants() {
         for z in &states {
             let r = residuals::<_, 2, 4>(&sys, &reference, &p, z, &tau);
             let h = 1e-6;
@@ -95,13 +113,36 @@ fn residual_jacobians_match_finite_differences() {
     }
 }
 
+/// Hybrid = the curved distances times `1 - tanh(alpha E)` and the torque
+/// times `tanh(alpha E) + beta` (the straight cost's blend); alpha = 0 and
+/// beta = 1 give the curved cost exactly.
+#[test]
+fn hybrid_is_the_curved_cost_blended_as_straight() {
+    let sys = DoublePendulum::default();
+    let z = Z::new(0.4, 0.3, -1.0, 0.5);
+    let tau = Vector::<2>::new(0.2, 0.1);
+    let mut p = params(Variant::Hybrid);
+    p.alpha = 0.3;
+    let c = residuals::<_, 2, 4>(&sys, &curved(), &p, &z, &tau);
+    let h = residuals::<_, 2, 4>(&sys, &hybrid(), &p, &z, &tau);
+    let (q, qd) = (Vector::<2>::new(z[0], z[1]), Vector::<2>::new(z[2], z[3]));
+    let t = (p.alpha * sys.energy(&q, &qd)).tanh();
+    assert!((h.position - c.position * (1.0 - t)).amax() < 1e-15);
+    assert!((h.velocity - c.velocity * (1.0 - t)).amax() < 1e-15);
+    assert!((h.torque - c.torque * (t + p.beta)).amax() < 1e-15);
+    assert_eq!(h.energy, c.energy);
+    p.alpha = 0.0;
+    p.beta = 1.0;
+    let c = stacked(&curved(), &p, &z, &tau);
+    assert_eq!(stacked(&hybrid(), &p, &z, &tau), c);
+}
+
 #[test]
 fn gauss_newton_model_is_psd_and_consistent_with_cost() {
     let sys = DoublePendulum::default();
     let z = Z::new(0.4, 0.3, -1.0, 0.5);
     let tau = Vector::<2>::new(0.2, 0.1);
-    for (reference, variant) in [(straight(), Variant::Straight), (curved(), Variant::Curved)] {
-        let p = params(variant);
+    for (reference, variant, p) in variants() {
         let m = stage_model::<_, 2, 4>(&sys, &reference, &p, &z, &tau, 0.025);
         let mut h = nalgebra::SMatrix::<f64, 6, 6>::zeros();
         h.fixed_view_mut::<4, 4>(0, 0).copy_from(&m.q);
@@ -401,4 +442,23 @@ fn e_ref_change_between_samples_changes_the_plan() {
     let ta = a.step(&z).tau;
     let tb = b.step(&z).tau;
     assert!((ta - tb).amax() > 1e-3, "{ta:?} vs {tb:?}");
+}
+
+/// Hybrid EigenMPC on an exact chart: pumps the paper's pendulum to 14 J
+/// (5 % band) and ends with small torque, as curved does.
+#[test]
+fn hybrid_closed_loop_reaches_the_mode() {
+    use eigenmpc::mpc::closed_loop::{run, summarise};
+    let sys = DoublePendulum::default();
+    let (mode, chart) = mode_and_chart::<_, 2, 4>(&sys, 0, 14.0, 9).unwrap();
+    let mut config = MpcConfig::paper(Variant::Hybrid);
+    config.cost.alpha = 0.01;
+    config.cost.beta = 0.9;
+    let mut ctrl = Controller::<_, 2, 4>::new(sys, config, Reference::Hybrid(chart)).unwrap();
+    let trace = run(&mut ctrl, &sys, &Z::new(0.05, 0.05, 0.0, 0.0), 30.0).unwrap();
+    let s = summarise(&trace, 14.0, Some(&mode.path), 5.0);
+    assert!(s.time_to_5_percent.is_some_and(|t| t < 25.0), "{s:?}");
+    assert!(s.rms_distance.unwrap() < 0.01, "{s:?}");
+    assert!(s.rms_torque.amax() < 0.05, "{s:?}");
+    assert_eq!(s.failures, 0);
 }

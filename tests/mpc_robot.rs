@@ -101,7 +101,7 @@ fn friction_compensating_residual_jacobians_match_finite_differences() {
             let f = sys.friction(&Vector::<2>::new(z[2], z[3]));
             let scale = match variant {
                 Variant::Curved => 1.0,
-                Variant::Straight => {
+                Variant::Straight | Variant::Hybrid => {
                     (p.alpha
                         * sys.energy(
                             &z.fixed_rows::<2>(0).into_owned(),

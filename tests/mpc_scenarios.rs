@@ -31,7 +31,7 @@ fn scenario_with(
         Variant::Straight => Reference::Straight {
             eigenvector: linear_modes(&sys).unwrap()[family].eigenvector,
         },
-        Variant::Curved => Reference::Curved(chart),
+        chart_variant => Reference::with_chart(chart_variant, chart),
     };
     let mut config = MpcConfig::paper(variant);
     config.cost.e_ref = e_ref;

@@ -316,11 +316,11 @@ fn invalid_parameters_are_rejected_with_a_message() {
         );
     }
     let fmu = Fmu::instantiate();
-    assert_eq!(fmu.set_int(&[vref("variant")], &[3]), ERROR);
+    assert_eq!(fmu.set_int(&[vref("variant")], &[4]), ERROR);
     assert!(
         fmu.instance
             .log
-            .contains(&["variant = 3 is above its maximum"])
+            .contains(&["variant = 4 is above its maximum"])
     );
     assert_eq!(unsafe { fmi2Reset(fmu.c) }, OK);
     assert_eq!(fmu.set_int(&[vref("horizon")], &[0]), ERROR);
@@ -440,6 +440,23 @@ fn chart_source_and_mode_select_the_reference() {
     let d = chart_distance(&chart_in_use(&computed), &anti.1);
     assert!(d < 2e-3, "anti-phase family at 3 J vs fitted: {d} rad");
     assert!(computed.instance.log.lines().iter().all(|l| l.status == OK));
+}
+
+/// variant = hybrid: the computed chart family, blended; a tuned E_ref
+/// moves its chart as for curved.
+#[test]
+fn hybrid_variant_follows_the_computed_family() {
+    let mut fmu = Fmu::start(&[], &[(vref("variant"), VARIANT_HYBRID)], Z0);
+    let instance = unsafe { &*(fmu.c as *const fmi2_slave::Instance<EigenMpcFmu>) };
+    let controller = instance.model().unwrap().controller();
+    assert_eq!(controller.reference().variant(), Variant::Hybrid);
+    assert_eq!(controller.config().cost.weights.energy, 25.0);
+    assert!(controller.family().is_some());
+    assert_eq!(fmu.step(DT), OK);
+    assert_eq!(fmu.set(&[vref("E_ref")], &[8.0]), OK);
+    assert_eq!(fmu.real(vref("chart_energy")), 8.0);
+    assert_eq!(fmu.step(DT), OK);
+    assert_eq!(fmu.integer(vref("solver_status")), 0);
 }
 
 #[test]

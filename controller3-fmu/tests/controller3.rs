@@ -193,7 +193,8 @@ fn start_values_of_a_robot_load_and_build_its_controller() {
     ] {
         assert!(names.contains(&name), "{name} in {names:?}");
     }
-    assert_eq!(names.len(), 1 + (10 * 3 + 2) + 3 + 30);
+    // E_ref, the model, c[j], the chart and chart_source = parameters
+    assert_eq!(names.len(), 1 + (10 * 3 + 2) + 3 + 30 + 1);
     assert!(
         names.contains(&"chart.coef[3,9]"),
         "zero-padded to 10 powers"
@@ -230,7 +231,14 @@ fn non_physical_models_are_refused_naming_the_parameter() {
             .log
             .contains(&["gr[2] = -1 is below its minimum"])
     );
-    let zero = ["c[1]", "c[2]", "c[3]"].map(|n| (n.to_string(), Value::Real(0.0)));
+    // a zero eigenvector, when the reference comes from the parameters
+    let mut zero: Vec<(String, Value)> = ["c[1]", "c[2]", "c[3]"]
+        .map(|n| (n.to_string(), Value::Real(0.0)))
+        .into();
+    zero.push((
+        "chart_source".into(),
+        Value::Integer(eigenmpc_fmu_models::enums::CHART_SOURCE_PARAMETERS),
+    ));
     let (fmu, status) = Fmu::start(&zero, Z0);
     assert_eq!(status, ERROR);
     assert!(fmu.instance.log.contains(&["eigenvector c = (0, 0, 0)"]));

@@ -91,6 +91,12 @@ pub const VARIANT: Enumeration<Variant> = Enumeration {
             value: Variant::Curved,
             description: "Distance to the eigenmode chart X(s)",
         },
+        Item {
+            name: "hybrid",
+            item: 3,
+            value: Variant::Hybrid,
+            description: "Distance to the chart X(s), blended by tanh(alpha E) as straight",
+        },
     ],
 };
 
@@ -138,6 +144,8 @@ pub const CHART_SOURCE: Enumeration<ChartSource> = Enumeration {
 pub const VARIANT_STRAIGHT: i32 = VARIANT.items[0].item;
 /// `variant` item: curved EigenMPC.
 pub const VARIANT_CURVED: i32 = VARIANT.items[1].item;
+/// `variant` item: hybrid EigenMPC.
+pub const VARIANT_HYBRID: i32 = VARIANT.items[2].item;
 /// `qp_solver` item: clarabel.
 pub const QP_SOLVER_CLARABEL: i32 = QP_SOLVER.items[0].item;
 /// `qp_solver` item: Riccati (default).
@@ -153,7 +161,7 @@ mod tests {
 
     #[test]
     fn every_library_value_has_one_item_and_back() {
-        for v in [Variant::Straight, Variant::Curved] {
+        for v in [Variant::Straight, Variant::Curved, Variant::Hybrid] {
             assert_eq!(VARIANT.value(VARIANT.item(v)), Ok(v));
         }
         for b in QpBackend::ALL {
@@ -165,9 +173,10 @@ mod tests {
             assert_eq!(CHART_SOURCE.value(CHART_SOURCE.item(c)), Ok(c));
         }
         assert_eq!((CHART_SOURCE_COMPUTED, CHART_SOURCE_PARAMETERS), (1, 2));
+        assert_eq!(VARIANT_HYBRID, 3);
         assert_eq!(
-            VARIANT.value(3),
-            Err("variant = 3 is not an item of Variant (1 straight, 2 curved)".into())
+            VARIANT.value(4),
+            Err("variant = 4 is not an item of Variant (1 straight, 2 curved, 3 hybrid)".into())
         );
         assert_eq!(
             QP_SOLVER.value(0),

@@ -126,7 +126,7 @@ where
 
 /// The cost reference of `variant` for the family `mode_index` at `energy`:
 /// the unit linear eigenvector (straight) or the degree-9 chart of the true
-/// eigenmode (curved).
+/// eigenmode (curved, hybrid).
 pub fn reference_for<S, const N: usize, const NX: usize>(
     system: &S,
     variant: super::Variant,
@@ -146,9 +146,10 @@ where
                 })?
                 .eigenvector,
         },
-        super::Variant::Curved => {
-            super::Reference::Curved(mode_and_chart::<S, N, NX>(system, mode_index, energy, 9)?.1)
-        }
+        chart_variant => super::Reference::with_chart(
+            chart_variant,
+            mode_and_chart::<S, N, NX>(system, mode_index, energy, 9)?.1,
+        ),
     })
 }
 

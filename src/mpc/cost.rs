@@ -43,6 +43,9 @@ pub enum Reference<const N: usize> {
     },
     /// Curved EigenMPC: a chart of the eigenmode at `E_ref`.
     Curved(Chart<N>),
+    /// Hybrid EigenMPC: the curved distance to the chart, blended by
+    /// `tanh(alpha E)` as in the straight cost.
+    Hybrid(Chart<N>),
 }
 
 impl<const N: usize> Reference<N> {
@@ -51,6 +54,35 @@ impl<const N: usize> Reference<N> {
         match self {
             Reference::Straight { .. } => Variant::Straight,
             Reference::Curved(_) => Variant::Curved,
+            Reference::Hybrid(_) => Variant::Hybrid,
+        }
+    }
+
+    /// The chart of `variant` (curved or hybrid); a straight variant gets
+    /// the chart's linear eigenvector.
+    pub fn with_chart(variant: Variant, chart: Chart<N>) -> Self {
+        match variant {
+            Variant::Straight => Reference::Straight {
+                eigenvector: chart.eigenvector,
+            },
+            Variant::Curved => Reference::Curved(chart),
+            Variant::Hybrid => Reference::Hybrid(chart),
+        }
+    }
+
+    /// The chart the cost follows (curved, hybrid).
+    pub fn chart(&self) -> Option<&Chart<N>> {
+        match self {
+            Reference::Straight { .. } => None,
+            Reference::Curved(chart) | Reference::Hybrid(chart) => Some(chart),
+        }
+    }
+
+    /// The chart, mutable (rewritten in place from a family).
+    pub fn chart_mut(&mut self) -> Option<&mut Chart<N>> {
+        match self {
+            Reference::Straight { .. } => None,
+            Reference::Curved(chart) | Reference::Hybrid(chart) => Some(chart),
         }
     }
 
@@ -58,7 +90,7 @@ impl<const N: usize> Reference<N> {
     pub fn validate(&self) -> Result<(), String> {
         let c = match self {
             Reference::Straight { eigenvector } => eigenvector,
-            Reference::Curved(chart) => {
+            Reference::Curved(chart) | Reference::Hybrid(chart) => {
                 if chart.coefficients.iter().flatten().any(|v| !v.is_finite())
                     || chart.equilibrium.iter().any(|v| !v.is_finite())
                 {
@@ -158,53 +190,75 @@ where
         Reference::Straight { eigenvector } => {
             let c = eigenvector;
             let perp = eye - c * c.transpose();
-            let t = (params.alpha * energy).tanh();
-            let dt_dz = grad_e * (params.alpha * (1.0 - t * t));
-            let g = 1.0 - t;
-            let dq = q - system.equilibrium();
-            let pdq = perp * dq;
-            let pqd = perp * qd;
-            r.position = pdq * g;
-            r.position_z
-                .fixed_view_mut::<N, N>(0, 0)
-                .copy_from(&(perp * g));
-            r.position_z -= pdq * dt_dz.transpose();
-            r.velocity = pqd * g;
-            r.velocity_z
-                .fixed_view_mut::<N, N>(0, N)
-                .copy_from(&(perp * g));
-            r.velocity_z -= pqd * dt_dz.transpose();
-            r.torque = torque * (t + params.beta);
-            r.torque_z = torque * dt_dz.transpose() + torque_z * (t + params.beta);
-            r.torque_u = eye * (t + params.beta);
+            r.position = perp * (q - system.equilibrium());
+            r.position_z.fixed_view_mut::<N, N>(0, 0).copy_from(&perp);
+            r.velocity = perp * qd;
+            r.velocity_z.fixed_view_mut::<N, N>(0, N).copy_from(&perp);
+            blend(&mut r, params, energy, &grad_e);
         }
-        Reference::Curved(chart) => {
-            let c0 = chart.eigenvector;
-            let s = chart.coordinate(&q);
-            let sd = c0.dot(&qd);
-            let p = chart.eval(s);
-            let norm = p.dx.norm().max(1e-12);
-            let c = p.dx / norm;
-            let dc = (p.ddx - c * c.dot(&p.ddx)) / norm;
-            let perp = eye - c * c.transpose();
-            let dperp = -(dc * c.transpose() + c * dc.transpose());
-            let along = eye - p.dx * c0.transpose();
-            let ex = q - p.x;
-            let ev = qd - p.dx * sd;
-            r.position = perp * ex;
-            r.position_z
-                .fixed_view_mut::<N, N>(0, 0)
-                .copy_from(&(perp * along + dperp * ex * c0.transpose()));
-            r.velocity = perp * ev;
-            r.velocity_z.fixed_view_mut::<N, N>(0, 0).copy_from(
-                &(-(perp * p.ddx) * (sd * c0.transpose()) + dperp * ev * c0.transpose()),
-            );
-            r.velocity_z
-                .fixed_view_mut::<N, N>(0, N)
-                .copy_from(&(perp * along));
+        Reference::Curved(chart) => chart_distance(&mut r, chart, &q, &qd),
+        Reference::Hybrid(chart) => {
+            chart_distance(&mut r, chart, &q, &qd);
+            blend(&mut r, params, energy, &grad_e);
         }
     }
     r
+}
+
+/// The curved distance (paper, eq. 12): position and velocity errors to
+/// the chart point at `s = c'(q - q_eq)`, across the chart's tangent.
+fn chart_distance<const N: usize, const NX: usize>(
+    r: &mut Residuals<N, NX>,
+    chart: &Chart<N>,
+    q: &Vector<N>,
+    qd: &Vector<N>,
+) {
+    let eye = Matrix::<N>::identity();
+    let c0 = chart.eigenvector;
+    let s = chart.coordinate(q);
+    let sd = c0.dot(qd);
+    let p = chart.eval(s);
+    let norm = p.dx.norm().max(1e-12);
+    let c = p.dx / norm;
+    let dc = (p.ddx - c * c.dot(&p.ddx)) / norm;
+    let perp = eye - c * c.transpose();
+    let dperp = -(dc * c.transpose() + c * dc.transpose());
+    let along = eye - p.dx * c0.transpose();
+    let ex = q - p.x;
+    let ev = qd - p.dx * sd;
+    r.position = perp * ex;
+    r.position_z
+        .fixed_view_mut::<N, N>(0, 0)
+        .copy_from(&(perp * along + dperp * ex * c0.transpose()));
+    r.velocity = perp * ev;
+    r.velocity_z
+        .fixed_view_mut::<N, N>(0, 0)
+        .copy_from(&(-(perp * p.ddx) * (sd * c0.transpose()) + dperp * ev * c0.transpose()));
+    r.velocity_z
+        .fixed_view_mut::<N, N>(0, N)
+        .copy_from(&(perp * along));
+}
+
+/// The straight cost's blending (paper, eq. 10): distances times
+/// `1 - tanh(alpha E)`, torque times `tanh(alpha E) + beta`, with the
+/// product rule through `E(z)`.
+fn blend<const N: usize, const NX: usize>(
+    r: &mut Residuals<N, NX>,
+    params: &CostParams,
+    energy: f64,
+    grad_e: &SVector<f64, NX>,
+) {
+    let t = (params.alpha * energy).tanh();
+    let dt_dz = grad_e * (params.alpha * (1.0 - t * t));
+    let g = 1.0 - t;
+    r.position_z = r.position_z * g - r.position * dt_dz.transpose();
+    r.position *= g;
+    r.velocity_z = r.velocity_z * g - r.velocity * dt_dz.transpose();
+    r.velocity *= g;
+    let w = t + params.beta;
+    r.torque_z = r.torque * dt_dz.transpose() + r.torque_z * w;
+    r.torque *= w;
+    r.torque_u = Matrix::<N>::identity() * w;
 }
 
 /// Gauss-Newton model of `scale * l(z, tau)`: value, gradient and Hessian

@@ -138,8 +138,23 @@ where
         config: MpcConfig,
         family: ChartFamily<N>,
     ) -> Result<Self, MpcError> {
+        Self::with_family_as(system, config, family, Variant::Curved)
+    }
+
+    /// [`Controller::with_family`] for a chart variant (curved or hybrid).
+    pub fn with_family_as(
+        system: S,
+        config: MpcConfig,
+        family: ChartFamily<N>,
+        variant: Variant,
+    ) -> Result<Self, MpcError> {
         config.validate()?;
-        let reference = Reference::Curved(family.chart(config.cost.e_ref));
+        if !variant.uses_chart() {
+            return Err(MpcError::InvalidReference(format!(
+                "a chart family needs a chart variant (curved, hybrid), not {variant}"
+            )));
+        }
+        let reference = Reference::with_chart(variant, family.chart(config.cost.e_ref));
         let mut controller = Self::new(system, config, reference)?;
         controller.family = Some(family);
         Ok(controller)
@@ -196,7 +211,7 @@ where
     /// Sets all tunable cost parameters at once (no rebuild, no allocation).
     pub fn set_cost(&mut self, cost: CostParams) -> Result<(), MpcError> {
         validate_cost(&cost)?;
-        if let (Some(family), Reference::Curved(chart)) = (&self.family, &mut self.reference)
+        if let (Some(family), Some(chart)) = (&self.family, self.reference.chart_mut())
             && cost.e_ref != self.config.cost.e_ref
         {
             family.write_chart(cost.e_ref, chart);

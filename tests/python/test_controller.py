@@ -45,7 +45,7 @@ def test_model_description(controller_md):
     for name in ["tau_max", "horizon", "sample_period", "m[1]", "g", "c[2]", "chart.coef[2,9]"]:
         assert v[name].variability == "fixed", name
     assert v["variant"].type == "Enumeration" and v["variant"].start == "2"
-    assert [i.name for i in v["variant"].declaredType.items] == ["straight", "curved"]
+    assert [i.name for i in v["variant"].declaredType.items] == ["straight", "curved", "hybrid"]
     assert v["tau[1]"].unit == "N.m" and v["solve_time"].unit == "s" and v["E_ref"].unit == "J"
     assert float(v["E_ref"].start) == 14.0 and float(v["w_E"].start) < 0
     assert float(v["sample_period"].start) == DT and v["horizon"].start == "80"

@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 /// Arguments of `eigenmpc simulate`.
 #[derive(Args, Debug)]
 pub struct SimulateArgs {
-    /// Cost variant: `straight` or `curved`.
+    /// Cost variant: `straight`, `curved` or `hybrid` (curved blended by tanh(alpha E)).
     #[arg(long, default_value = "curved")]
     variant: String,
     /// Mode family: `in-phase` or `anti-phase`.
@@ -225,7 +225,7 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
     };
     let model = plant.with_coulomb_sharpness(sharpness)?;
     let e_final = schedule.last().map_or(args.energy, |s| s.1);
-    let use_family = variant == Variant::Curved && (args.chart_family || !schedule.is_empty());
+    let use_family = variant.uses_chart() && (args.chart_family || !schedule.is_empty());
     let mut controller = if use_family {
         if args.chart.is_some() {
             bail!("--chart and a chart family (--chart-family, --e-ref-at) exclude each other");
@@ -247,25 +247,28 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
         if let Some(why) = chart_family.ended_early() {
             eprintln!("  (ends below {e_max} J: {why})");
         }
-        Controller::<_, 2, 4>::with_family(model, config, chart_family)?
+        Controller::<_, 2, 4>::with_family_as(model, config, chart_family, variant)?
     } else {
         let reference = match variant {
             Variant::Straight => Reference::Straight {
                 eigenvector: linear_modes(&model)?[family.index()].eigenvector,
             },
-            Variant::Curved => Reference::Curved(match &args.chart {
-                Some(path) => chart_from_json(path, args.energy)?,
-                None => {
-                    mode_and_chart::<_, 2, 4>(
-                        &model,
-                        family.index(),
-                        args.energy,
-                        args.chart_degree,
-                    )
-                    .with_context(|| format!("{family} eigenmode at {} J", args.energy))?
-                    .1
-                }
-            }),
+            chart_variant => Reference::with_chart(
+                chart_variant,
+                match &args.chart {
+                    Some(path) => chart_from_json(path, args.energy)?,
+                    None => {
+                        mode_and_chart::<_, 2, 4>(
+                            &model,
+                            family.index(),
+                            args.energy,
+                            args.chart_degree,
+                        )
+                        .with_context(|| format!("{family} eigenmode at {} J", args.energy))?
+                        .1
+                    }
+                },
+            ),
         };
         Controller::<_, 2, 4>::new(model, config, reference)?
     };

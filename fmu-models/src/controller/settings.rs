@@ -175,7 +175,7 @@ impl<const N: usize> Settings<N> {
     }
 
     /// The reference of the variant on `system`: the eigenvector line
-    /// (straight) or the chart (curved), checked to belong together.
+    /// (straight) or the chart (curved, hybrid), checked to belong together.
     pub fn reference(&self, system: &PlanarChain<N>) -> Result<Reference<N>, String> {
         let c = Vector::<N>::from(self.eigenvector);
         if !c.iter().all(|v| v.is_finite()) || c.norm() < 1e-6 {
@@ -188,7 +188,7 @@ impl<const N: usize> Settings<N> {
         let c = c.normalize();
         match self.variant {
             Variant::Straight => Ok(Reference::Straight { eigenvector: c }),
-            Variant::Curved => {
+            chart_variant => {
                 let chart = Chart::from_coefficients(
                     c,
                     system.equilibrium(),
@@ -205,7 +205,7 @@ impl<const N: usize> Settings<N> {
                          (a chart fitted in s = c'q has 1); pass the c[j] written with the chart"
                     ));
                 }
-                Ok(Reference::Curved(chart))
+                Ok(Reference::with_chart(chart_variant, chart))
             }
         }
     }
@@ -229,9 +229,10 @@ impl<const N: usize> Settings<N> {
                 Controller::new(system, config, Reference::Straight { eigenvector })
                     .map_err(|e| e.to_string())
             }
-            (ChartSource::Computed, Variant::Curved) => {
+            (ChartSource::Computed, chart_variant) => {
                 let family = self.family::<NX>(&system)?;
-                Controller::with_family(system, config, family).map_err(|e| e.to_string())
+                Controller::with_family_as(system, config, family, chart_variant)
+                    .map_err(|e| e.to_string())
             }
         }
     }
