@@ -6,7 +6,7 @@
 use eigenmpc::mechanics::DoublePendulum;
 use eigenmpc::modes::{ChartFamily, FamilyOptions, linear_modes};
 use eigenmpc::mpc::closed_loop::mode_and_chart;
-use eigenmpc::mpc::{Controller, MpcConfig, QpBackend, Reference, Variant};
+use eigenmpc::mpc::{Controller, EstimatorConfig, MpcConfig, QpBackend, Reference, Variant};
 use eigenmpc::qp::clarabel::{ClarabelQpSolver, rti_settings};
 use eigenmpc::qp::{OcpQp, QpSolution, QpSolver, QpStatus};
 use nalgebra::SVector;
@@ -148,4 +148,30 @@ fn control_steps_do_not_allocate() {
     }
     let total = OURS.load(Ordering::SeqCst) + BACKEND.load(Ordering::SeqCst) - before;
     assert_eq!(total, 0, "family controller allocated {total} times");
+
+    // With the state estimator: predict and correct allocate nothing.
+    let (_, chart) = mode_and_chart::<_, 2, 4>(&sys, 0, 14.0, 9).unwrap();
+    let mut config = MpcConfig::paper(Variant::Curved);
+    config.horizon = 40;
+    config.estimator = Some(EstimatorConfig {
+        angle_noise: 0.05,
+        speed_noise: 0.05,
+        acceleration_noise: 0.3,
+    });
+    let mut ctrl = Controller::<_, 2, 4>::new(sys, config, Reference::Curved(chart)).unwrap();
+    let mut z = SVector::<f64, 4>::new(0.3, 0.2, 0.0, 0.0);
+    z = eigenmpc::integrate::rk4_step::<_, 2, 4>(&sys, &z, &ctrl.step(&z).tau, 0.025);
+    let before = OURS.load(Ordering::SeqCst) + BACKEND.load(Ordering::SeqCst);
+    for k in 0..50 {
+        let noisy = z.map(|v| v + 0.01 * ((k * 7919) % 13) as f64 / 13.0);
+        let out = ctrl.step(&noisy);
+        assert!(out.status.is_ok());
+        assert!(ctrl.state_estimate().is_some());
+        z = eigenmpc::integrate::rk4_step::<_, 2, 4>(&sys, &z, &out.tau, 0.025);
+    }
+    let total = OURS.load(Ordering::SeqCst) + BACKEND.load(Ordering::SeqCst) - before;
+    assert_eq!(
+        total, 0,
+        "controller with estimator allocated {total} times"
+    );
 }

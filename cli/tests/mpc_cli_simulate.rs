@@ -90,6 +90,15 @@ fn simulate_refuses_bad_input_with_a_message() {
         (vec!["simulate", "--dt", "-1", "--duration", "1"], "dt"),
         (vec!["simulate", "--energy", "nan"], "--energy"),
         (vec!["simulate", "--qp", "hpipm"], "unknown QP backend"),
+        (vec!["simulate", "--ekf", "0.05,0.05"], "--ekf needs three"),
+        (
+            vec!["simulate", "--ekf", "0.05,0,0.3", "--duration", "1"],
+            "speed_noise = 0 is invalid",
+        ),
+        (
+            vec!["simulate", "--noise", "-1", "--duration", "1"],
+            "--noise",
+        ),
         (
             vec![
                 "simulate",
@@ -163,4 +172,32 @@ fn simulate_qp_backends_agree() {
         "clarabel vs riccati energy differ by {worst:e} J"
     );
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Measurement noise of 0.05 rad and rad/s: the EKF keeps it out of the torque.
+#[test]
+fn simulate_noise_with_and_without_the_estimator() {
+    let rms = |extra: &[&str]| -> f64 {
+        let mut args = vec!["simulate", "--noise", "0.05", "--duration", "30"];
+        args.extend_from_slice(extra);
+        let out = eigenmpc(&args);
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(out.status.success(), "{stdout}");
+        let line = stdout
+            .lines()
+            .find(|l| l.starts_with("RMS torque, last 5 s:"))
+            .unwrap();
+        line.split_once(':')
+            .unwrap()
+            .1
+            .split_whitespace()
+            .filter_map(|w| w.parse::<f64>().ok())
+            .fold(0.0, f64::max)
+    };
+    let with = rms(&["--ekf", "0.05,0.05,0.3"]);
+    let without = rms(&[]);
+    assert!(
+        with < 0.1 && without > 0.3,
+        "with EKF {with}, without {without}"
+    );
 }

@@ -17,7 +17,8 @@ pub use eigenmpc_fmu_models::controller::start_values::start_values;
 pub use eigenmpc_fmu_models::controller::{ControllerProduct, description};
 pub use eigenmpc_fmu_models::enums::{
     CHART_SOURCE, CHART_SOURCE_COMPUTED, CHART_SOURCE_PARAMETERS, QP_SOLVER, QP_SOLVER_CLARABEL,
-    QP_SOLVER_RICCATI, VARIANT, VARIANT_CURVED, VARIANT_HYBRID, VARIANT_STRAIGHT,
+    QP_SOLVER_RICCATI, STATE_ESTIMATOR, STATE_ESTIMATOR_EKF, STATE_ESTIMATOR_NONE, VARIANT,
+    VARIANT_CURVED, VARIANT_HYBRID, VARIANT_STRAIGHT,
 };
 pub use eigenmpc_fmu_models::products::{
     DEFAULT_CHART_14J, DEFAULT_EIGENVECTOR, EigenMpc2, EigenMpcFmu,

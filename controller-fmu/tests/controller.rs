@@ -459,6 +459,47 @@ fn hybrid_variant_follows_the_computed_family() {
     assert_eq!(fmu.integer(vref("solver_status")), 0);
 }
 
+/// state_estimator = ekf with its noise levels: the FMU filters noisy
+/// inputs exactly as the library's controller with that estimator does.
+#[test]
+fn state_estimator_filters_the_inputs_like_the_library() {
+    let mut fmu = Fmu::start(
+        &[
+            (vref("angle_noise"), 0.02),
+            (vref("acceleration_noise"), 0.5),
+        ],
+        &[(vref("state_estimator"), STATE_ESTIMATOR_EKF)],
+        Z0,
+    );
+    let mut settings = EigenMpc2::settings(Variant::Curved);
+    settings.state_estimator = settings::StateEstimator::Ekf;
+    settings.noise.angle_noise = 0.02;
+    settings.noise.acceleration_noise = 0.5;
+    let mut native = settings.build::<4>().unwrap();
+    assert_eq!(native.config().estimator, Some(settings.noise));
+    let first = native.step(&SVector::from(Z0)).tau;
+    assert_eq!(fmu.tau(), [first[0], first[1]]);
+    // t = 0: solved at initialization (same inputs: no new solve)
+    assert_eq!(fmu.set(&state(), &Z0), OK);
+    assert_eq!(fmu.step(DT), OK);
+    for (k, (z, _)) in native_trace(0.5).iter().enumerate().skip(1) {
+        let noisy = z.map(|v| v + 0.01 * (((k * 37) % 11) as f64 - 5.0) / 5.0);
+        assert_eq!(fmu.set(&state(), noisy.as_slice()), OK);
+        assert_eq!(fmu.step(DT), OK);
+        let tau = native.step(&noisy).tau;
+        assert_eq!(fmu.tau(), [tau[0], tau[1]], "sample {k}");
+    }
+    let instance = unsafe { &*(fmu.c as *const fmi2_slave::Instance<EigenMpcFmu>) };
+    assert!(
+        instance
+            .model()
+            .unwrap()
+            .controller()
+            .state_estimate()
+            .is_some()
+    );
+}
+
 #[test]
 fn straight_variant_uses_its_paper_weight() {
     let fmu = Fmu::start(&[], &[(vref("variant"), VARIANT_STRAIGHT)], Z0);

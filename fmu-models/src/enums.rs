@@ -2,7 +2,7 @@
 //! (name, item, library value, description), used by the FMU variable
 //! tables, the C API and the C header.
 
-use crate::controller::settings::ChartSource;
+use crate::controller::settings::{ChartSource, StateEstimator};
 use eigenmpc::mpc::{QpBackend, Variant};
 use fmi2_slave::EnumerationType;
 
@@ -140,6 +140,26 @@ pub const CHART_SOURCE: Enumeration<ChartSource> = Enumeration {
     ],
 };
 
+/// `state_estimator`: what filters the measured state.
+pub const STATE_ESTIMATOR: Enumeration<StateEstimator> = Enumeration {
+    type_name: "StateEstimator",
+    parameter: "state_estimator",
+    items: &[
+        Item {
+            name: "none",
+            item: 1,
+            value: StateEstimator::None,
+            description: "The measured q, qd are used as they are",
+        },
+        Item {
+            name: "ekf",
+            item: 2,
+            value: StateEstimator::Ekf,
+            description: "Extended Kalman filter on the controller's model and the applied torque",
+        },
+    ],
+};
+
 /// `variant` item: straight EigenMPC.
 pub const VARIANT_STRAIGHT: i32 = VARIANT.items[0].item;
 /// `variant` item: curved EigenMPC.
@@ -150,6 +170,10 @@ pub const VARIANT_HYBRID: i32 = VARIANT.items[2].item;
 pub const QP_SOLVER_CLARABEL: i32 = QP_SOLVER.items[0].item;
 /// `qp_solver` item: Riccati (default).
 pub const QP_SOLVER_RICCATI: i32 = QP_SOLVER.items[1].item;
+/// `state_estimator` item: none (default).
+pub const STATE_ESTIMATOR_NONE: i32 = STATE_ESTIMATOR.items[0].item;
+/// `state_estimator` item: extended Kalman filter.
+pub const STATE_ESTIMATOR_EKF: i32 = STATE_ESTIMATOR.items[1].item;
 /// `chart_source` item: computed from the model (default).
 pub const CHART_SOURCE_COMPUTED: i32 = CHART_SOURCE.items[0].item;
 /// `chart_source` item: the chart parameters.
@@ -173,6 +197,10 @@ mod tests {
             assert_eq!(CHART_SOURCE.value(CHART_SOURCE.item(c)), Ok(c));
         }
         assert_eq!((CHART_SOURCE_COMPUTED, CHART_SOURCE_PARAMETERS), (1, 2));
+        for e in [StateEstimator::None, StateEstimator::Ekf] {
+            assert_eq!(STATE_ESTIMATOR.value(STATE_ESTIMATOR.item(e)), Ok(e));
+        }
+        assert_eq!((STATE_ESTIMATOR_NONE, STATE_ESTIMATOR_EKF), (1, 2));
         assert_eq!(VARIANT_HYBRID, 3);
         assert_eq!(
             VARIANT.value(4),

@@ -7,6 +7,7 @@ pub fn all() -> Vec<Unit> {
     vec![
         Unit::new("rad", 0, 0, 0, 1),
         Unit::new("rad/s", 0, 0, -1, 1),
+        Unit::new("rad/s2", 0, 0, -2, 1),
         Unit::new("N.m", 1, 2, -2, 0),
         Unit::new("J", 1, 2, -2, 0),
         Unit::new("1/J", -1, -2, 2, 0),

@@ -93,7 +93,10 @@ fn the_two_joint_controller_keeps_the_original_value_references() {
     assert_eq!(vr(&d, "mode"), (BaseType::Integer, 6));
     assert_eq!(vr(&d, "family_energy_max"), (BaseType::Real, 137));
     assert_eq!(vr(&d, "chart_energy_max"), (BaseType::Real, 140));
-    assert_eq!(d.variables.len(), 24 + 20 + 5 + 17 + 6);
+    // then the state estimator
+    assert_eq!(vr(&d, "state_estimator"), (BaseType::Integer, 7));
+    assert_eq!(vr(&d, "acceleration_noise"), (BaseType::Real, 143));
+    assert_eq!(d.variables.len(), 24 + 20 + 5 + 17 + 6 + 4);
 }
 
 /// Every variable of the original `DoublePendulum.fmu` keeps its name and

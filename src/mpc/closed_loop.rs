@@ -56,7 +56,33 @@ where
     S: MechanicalSystem<N>,
     P: MechanicalSystem<N>,
 {
-    run_inner(controller, plant, z0, duration, |_, _| {}, on_sample)
+    run_inner(
+        controller,
+        plant,
+        z0,
+        duration,
+        |_, _| {},
+        on_sample,
+        |_, z| *z,
+    )
+}
+
+/// [`run_tuned`] with a measurement: the controller gets `measure(t, z)`
+/// instead of the plant's state `z` (noise, delay, ...); the samples record
+/// the true state and energy.
+pub fn run_measured<S, P, const N: usize, const NX: usize>(
+    controller: &mut Controller<S, N, NX>,
+    plant: &P,
+    z0: &SVector<f64, NX>,
+    duration: f64,
+    tune: impl FnMut(f64, &mut Controller<S, N, NX>),
+    measure: impl FnMut(f64, &SVector<f64, NX>) -> SVector<f64, NX>,
+) -> Result<Vec<Sample<N, NX>>, IntegrationError>
+where
+    S: MechanicalSystem<N>,
+    P: MechanicalSystem<N>,
+{
+    run_inner(controller, plant, z0, duration, tune, |_, _, _| {}, measure)
 }
 
 /// [`run`], calling `tune(t, controller)` right before the controller's
@@ -73,7 +99,15 @@ where
     S: MechanicalSystem<N>,
     P: MechanicalSystem<N>,
 {
-    run_inner(controller, plant, z0, duration, tune, |_, _, _| {})
+    run_inner(
+        controller,
+        plant,
+        z0,
+        duration,
+        tune,
+        |_, _, _| {},
+        |_, z| *z,
+    )
 }
 
 fn run_inner<S, P, const N: usize, const NX: usize>(
@@ -83,6 +117,7 @@ fn run_inner<S, P, const N: usize, const NX: usize>(
     duration: f64,
     mut tune: impl FnMut(f64, &mut Controller<S, N, NX>),
     mut on_sample: impl FnMut(usize, &Controller<S, N, NX>, &ControlOutput<N>),
+    mut measure: impl FnMut(f64, &SVector<f64, NX>) -> SVector<f64, NX>,
 ) -> Result<Vec<Sample<N, NX>>, IntegrationError>
 where
     S: MechanicalSystem<N>,
@@ -100,7 +135,7 @@ where
         let t = i as f64 * dt;
         let z = *ode.state();
         tune(t, controller);
-        let out = controller.step(&z);
+        let out = controller.step(&measure(t, &z));
         on_sample(i, controller, &out);
         trace.push(Sample {
             time: t,
@@ -151,6 +186,48 @@ where
             mode_and_chart::<S, N, NX>(system, mode_index, energy, 9)?.1,
         ),
     })
+}
+
+/// Deterministic Gaussian noise for measured closed loops (xorshift64* and
+/// Box-Muller): the same seed gives the same sequence on every machine.
+#[derive(Clone, Debug)]
+pub struct GaussianNoise(u64);
+
+impl GaussianNoise {
+    /// A generator with `seed` (0 is replaced by a fixed nonzero seed).
+    pub fn new(seed: u64) -> Self {
+        Self(if seed == 0 {
+            0x9e37_79b9_7f4a_7c15
+        } else {
+            seed
+        })
+    }
+
+    /// Uniform in (0, 1).
+    fn uniform(&mut self) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        let x = self.0.wrapping_mul(0x2545_f491_4f6c_dd1d);
+        ((x >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    }
+
+    /// One standard normal sample.
+    pub fn sample(&mut self) -> f64 {
+        let (u, v) = (self.uniform(), self.uniform());
+        (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
+    }
+
+    /// `z` with independent noise of standard deviation `angle` (rad) on
+    /// the angles and `speed` (rad/s) on the speeds.
+    pub fn measure<const NX: usize>(
+        &mut self,
+        z: &SVector<f64, NX>,
+        angle: f64,
+        speed: f64,
+    ) -> SVector<f64, NX> {
+        SVector::from_fn(|i, _| z[i] + if i < NX / 2 { angle } else { speed } * self.sample())
+    }
 }
 
 /// Summary figures of a run (issue 3 / paper section V).

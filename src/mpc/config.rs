@@ -3,6 +3,7 @@
 
 use super::Variant;
 use super::cost::{CostParams, Weights};
+use super::estimator::EstimatorConfig;
 use crate::qp::QpBackend;
 use thiserror::Error;
 
@@ -59,6 +60,9 @@ pub struct MpcConfig {
     pub sqp: SqpOptions,
     /// QP solver built by [`Controller::new`] (default riccati, see docs/results.md).
     pub qp: QpBackend,
+    /// State estimator on the measured state (None, the default: the
+    /// measurement is used as it is).
+    pub estimator: Option<EstimatorConfig>,
 }
 
 impl MpcConfig {
@@ -87,6 +91,7 @@ impl MpcConfig {
             converge_first_sample: true,
             sqp: SqpOptions::default(),
             qp: QpBackend::default(),
+            estimator: None,
         }
     }
 
@@ -135,6 +140,9 @@ impl MpcConfig {
                 self.iterations_per_sample as f64,
                 "must be in 1..=100",
             );
+        }
+        if let Some(e) = &self.estimator {
+            e.validate()?;
         }
         if self.sqp.max_iterations == 0 {
             return bad("sqp.max_iterations", 0.0, "must be >= 1");

@@ -18,6 +18,7 @@
 pub mod closed_loop;
 mod config;
 pub mod cost;
+mod estimator;
 mod linearise;
 pub mod prediction;
 mod sqp;
@@ -26,6 +27,7 @@ mod variant;
 
 pub use config::{MAX_HORIZON, MpcConfig, MpcError, SqpOptions};
 pub use cost::{CostParams, Reference, Weights};
+pub use estimator::EstimatorConfig;
 pub use prediction::{prediction_coulomb_sharpness, prediction_substeps};
 pub use status::{ControlOutput, ControlStatus};
 pub use variant::{VARIANTS, Variant, VariantInfo};
@@ -67,6 +69,10 @@ pub struct Controller<S, const N: usize, const NX: usize> {
     consecutive_qp_failures: usize,
     /// The eigenmanifold the curved chart follows `E_ref` on (None: fixed chart).
     family: Option<ChartFamily<N>>,
+    /// State estimator (None: the measured state is used as it is).
+    estimator: Option<estimator::Ekf<N, NX>>,
+    /// Torque returned by the last feedback (applied over the last sample).
+    applied_tau: Vector<N>,
 }
 
 /// QP failures in a row after which the plan is discarded and the next
@@ -123,6 +129,8 @@ where
             warm_start_usable: false,
             consecutive_qp_failures: 0,
             family: None,
+            estimator: config.estimator.map(|e| estimator::Ekf::new(&e, config.dt)),
+            applied_tau: Vector::zeros(),
         })
     }
 
@@ -262,6 +270,29 @@ where
         self.merit_penalty = 1.0;
         self.warm_start_usable = false;
         self.consecutive_qp_failures = 0;
+        if let Some(ekf) = &mut self.estimator {
+            ekf.reset();
+        }
+    }
+
+    /// The state estimate the last sample used (None without an estimator
+    /// or before the first sample).
+    pub fn state_estimate(&self) -> Option<&SVector<f64, NX>> {
+        self.estimator.as_ref().and_then(|e| e.estimate())
+    }
+
+    /// Propagates the state estimate over the last sample with the torque
+    /// applied (once per sample; part of the preparation).
+    fn predict_estimate(&mut self) {
+        let Some(ekf) = &self.estimator else { return };
+        if !ekf.needs_prediction() {
+            return;
+        }
+        let from = *ekf.estimate().expect("started");
+        let (next, a, _) = self.interval_sensitivity(&from, &self.applied_tau);
+        if let Some(ekf) = &mut self.estimator {
+            ekf.predict(&next, &a);
+        }
     }
 
     /// One control step: preparation (unless already done) and feedback.
@@ -273,10 +304,12 @@ where
     /// Preparation phase: shift the previous plan and linearise around it.
     /// Call between samples (before the measurement arrives) to cut latency.
     pub fn prepare(&mut self) {
+        let start = Instant::now();
+        self.predict_estimate();
         if !self.initialised {
+            self.pending_preparation_time += start.elapsed().as_secs_f64();
             return;
         }
-        let start = Instant::now();
         if self.shift_pending {
             self.shift();
             self.solver.shift_warm_start(self.warm_start_usable);
@@ -293,8 +326,23 @@ where
     /// Feedback phase: embed the measured state, solve, return `tau_0`.
     pub fn feedback(&mut self, z: &SVector<f64, NX>) -> ControlOutput<N> {
         let start = Instant::now();
+        let measured = z.iter().all(|v| v.is_finite());
+        // A prediction not made in `prepare` (feedback called alone) is made here.
+        self.predict_estimate();
+        let estimate;
+        let z = match &mut self.estimator {
+            Some(ekf) if measured => {
+                estimate = ekf.update(z);
+                &estimate
+            }
+            Some(ekf) => {
+                ekf.skip_update();
+                z
+            }
+            None => z,
+        };
         let preparation_time = std::mem::take(&mut self.pending_preparation_time);
-        let mut out = if !z.iter().all(|v| v.is_finite()) {
+        let mut out = if !measured {
             self.fallback(ControlStatus::InvalidState)
         } else if !self.initialised {
             self.initialise(z);
@@ -326,6 +374,7 @@ where
             }
             ControlStatus::InvalidState => {}
         }
+        self.applied_tau = out.tau;
         out.preparation_time = preparation_time;
         out.feedback_time = start.elapsed().as_secs_f64();
         out

@@ -7,11 +7,12 @@ use clap::Args;
 use eigenmpc::mechanics::Vector;
 use eigenmpc::modes::{Chart, ChartFamily, Family, FamilyOptions, linear_modes};
 use eigenmpc::mpc::closed_loop::{
-    Summary, energy_tail, mode_and_chart, rms_friction_torque, run_tuned, summarise,
+    GaussianNoise, Summary, energy_tail, mode_and_chart, rms_friction_torque, run_measured,
+    summarise,
 };
 use eigenmpc::mpc::{
-    Controller, MpcConfig, QpBackend, Reference, Variant, prediction_coulomb_sharpness,
-    prediction_substeps,
+    Controller, EstimatorConfig, MpcConfig, QpBackend, Reference, Variant,
+    prediction_coulomb_sharpness, prediction_substeps,
 };
 use eigenmpc_cli::report::{plot_run, summary_text, write_csv};
 use nalgebra::SVector;
@@ -101,6 +102,18 @@ pub struct SimulateArgs {
     /// Penalise the whole torque tau instead of tau - tau_f(qd) (friction fought, not compensated).
     #[arg(long)]
     no_friction_compensation: bool,
+    /// Measurement noise: standard deviation added to every measured angle
+    /// (rad) and speed (rad/s), Gaussian, deterministic (see --seed).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    noise: f64,
+    /// Seed of the measurement noise.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Filter the measurement with the controller's extended Kalman filter:
+    /// `ANGLE,SPEED,ACCELERATION` noise levels (rad, rad/s, rad/s^2), e.g.
+    /// `0.05,0.05,0.3`.
+    #[arg(long, value_name = "ANGLE,SPEED,ACCEL")]
+    ekf: Option<String>,
     #[command(flatten)]
     model: ModelArgs,
 }
@@ -212,6 +225,20 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
     config.cost.alpha = args.alpha;
     config.cost.beta = args.beta;
     config.cost.compensate_friction = !args.no_friction_compensation;
+    if let Some(text) = &args.ekf {
+        let levels = super::parse_list("ekf", text)?;
+        let [angle_noise, speed_noise, acceleration_noise] = levels[..] else {
+            bail!("--ekf needs three noise levels ANGLE,SPEED,ACCEL");
+        };
+        config.estimator = Some(EstimatorConfig {
+            angle_noise,
+            speed_noise,
+            acceleration_noise,
+        });
+    }
+    if !(args.noise.is_finite() && args.noise >= 0.0) {
+        bail!("--noise must be finite and >= 0");
+    }
     if let Some(w) = args.w_e {
         config.cost.weights.energy = w;
     }
@@ -276,13 +303,27 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
         .with_context(|| format!("{family} eigenmode of the plant at {e_final} J"))?;
     let z0 = SVector::<f64, 4>::from_column_slice(&x0);
     let mut next = 0;
-    let trace = run_tuned(&mut controller, &plant, &z0, args.duration, |t, c| {
-        while next < schedule.len() && schedule[next].0 <= t + 1e-9 {
-            // Validated above: finite and > 0.
-            let _ = c.set_e_ref(schedule[next].1);
-            next += 1;
-        }
-    })?;
+    let mut noise = GaussianNoise::new(args.seed);
+    let trace = run_measured(
+        &mut controller,
+        &plant,
+        &z0,
+        args.duration,
+        |t, c| {
+            while next < schedule.len() && schedule[next].0 <= t + 1e-9 {
+                // Validated above: finite and > 0.
+                let _ = c.set_e_ref(schedule[next].1);
+                next += 1;
+            }
+        },
+        |_, z| {
+            if args.noise > 0.0 {
+                noise.measure(z, args.noise, args.noise)
+            } else {
+                *z
+            }
+        },
+    )?;
     let summary = summarise(&trace, e_final, Some(&mode.path), 5.0);
     print_summary(args, variant, family, &summary);
     let (mean, rms) = energy_tail(&trace, e_final, 5.0);

@@ -6,7 +6,8 @@ use crate::chain::{ChainParameters, HasChain};
 use eigenmpc::mechanics::{MechanicalSystem, PlanarChain, Vector};
 use eigenmpc::modes::{Chart, ChartFamily, FamilyOptions, linear_modes};
 use eigenmpc::mpc::{
-    Controller, CostParams, MpcConfig, QpBackend, Reference, Variant, Weights, prediction_substeps,
+    Controller, CostParams, EstimatorConfig, MpcConfig, QpBackend, Reference, Variant, Weights,
+    prediction_substeps,
 };
 
 /// Number of chart coefficients per joint (powers `0..=9`, the paper's degree).
@@ -88,6 +89,15 @@ pub enum ChartSource {
     Parameters,
 }
 
+/// Which state estimator filters the measured state.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StateEstimator {
+    /// None: the measurement is used as it is.
+    None,
+    /// Extended Kalman filter on the controller's model.
+    Ekf,
+}
+
 /// One controller's full definition.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Settings<const N: usize> {
@@ -118,6 +128,10 @@ pub struct Settings<const N: usize> {
     /// of [`FamilyOptions::for_system`] (half the upright potential, at
     /// least 1.25 `E_ref`).
     pub family_energy_max: f64,
+    /// State estimator on the measured state.
+    pub state_estimator: StateEstimator,
+    /// Its noise levels (used with [`StateEstimator::Ekf`]).
+    pub noise: EstimatorConfig,
 }
 
 impl<const N: usize> HasChain<N> for Settings<N> {
@@ -155,6 +169,12 @@ impl<const N: usize> Settings<N> {
             chart_source: ChartSource::Computed,
             mode: 0,
             family_energy_max: -1.0,
+            state_estimator: StateEstimator::None,
+            noise: EstimatorConfig {
+                angle_noise: 0.05,
+                speed_noise: 0.05,
+                acceleration_noise: 0.3,
+            },
         }
     }
 
@@ -166,6 +186,10 @@ impl<const N: usize> Settings<N> {
         config.tau_max = self.tau_max;
         config.cost = self.tuning.cost(self.variant);
         config.qp = self.qp;
+        config.estimator = match self.state_estimator {
+            StateEstimator::None => None,
+            StateEstimator::Ekf => Some(self.noise),
+        };
         config
     }
 

@@ -21,7 +21,7 @@
 
 use super::settings::{CHART_COEFFICIENTS, Settings};
 use crate::chain::{point_mass_rows, rigid_rows};
-use crate::enums::{CHART_SOURCE, QP_SOLVER, VARIANT};
+use crate::enums::{CHART_SOURCE, QP_SOLVER, STATE_ESTIMATOR, VARIANT};
 use fmi2_slave::table::{Deps, Field, Row, Shape, Table};
 
 /// Group tag of the reference rows (`E_ref`, `c[j]`, `chart.coef[j,k]`),
@@ -225,6 +225,7 @@ pub fn table<const N: usize>() -> Table<Settings<N>> {
     ]);
     rows.extend(rigid_rows::<Settings<N>, N>("Controller model: "));
     rows.extend(computed_reference_rows::<N>());
+    rows.extend(estimator_rows::<N>());
     Table::new(N, rows)
 }
 
@@ -288,6 +289,58 @@ fn computed_reference_rows<const N: usize>() -> Vec<Rw<N>> {
             "chart_energy_max",
             "Highest energy of the computed mode family: where the continuation or the \
              chart fit ended, or family_energy_max (0 for a fixed chart or straight)",
+        ),
+    ]
+}
+
+/// The rows of the state estimator (`state_estimator`).
+fn estimator_rows<const N: usize>() -> Vec<Rw<N>> {
+    let level = |name,
+                 get: fn(&Settings<N>, _) -> f64,
+                 set: fn(&mut Settings<N>, _, f64),
+                 unit,
+                 what: &str| {
+        Rw::<N>::real(name, Shape::Scalar)
+            .parameter(Field::real(get, set))
+            .unit(unit)
+            .range(1e-9, 1e3)
+            .describe(format!("State estimator: {what}"))
+    };
+    vec![
+        Rw::<N>::enumeration(
+            STATE_ESTIMATOR.parameter,
+            Shape::Scalar,
+            STATE_ESTIMATOR.fmi_type(),
+        )
+        .parameter(Field::integer(
+            |s, _| STATE_ESTIMATOR.item(s.state_estimator),
+            |s, _, v| s.state_estimator = STATE_ESTIMATOR.value(v).unwrap_or(s.state_estimator),
+        ))
+        .describe(
+            "What filters the measured q, qd before a solve: none (default) or ekf, an \
+             extended Kalman filter on the controller's model and the torque it applied",
+        ),
+        level(
+            "angle_noise",
+            |s, _| s.noise.angle_noise,
+            |s, _, v| s.noise.angle_noise = v,
+            "rad",
+            "standard deviation of the measured angles' noise",
+        ),
+        level(
+            "speed_noise",
+            |s, _| s.noise.speed_noise,
+            |s, _, v| s.noise.speed_noise = v,
+            "rad/s",
+            "standard deviation of the measured speeds' noise",
+        ),
+        level(
+            "acceleration_noise",
+            |s, _| s.noise.acceleration_noise,
+            |s, _, v| s.noise.acceleration_noise = v,
+            "rad/s2",
+            "unmodelled acceleration per joint, constant over a sample (larger trusts the \
+             measurement more, smaller the model)",
         ),
     ]
 }
