@@ -1,0 +1,390 @@
+//! Online identification of a planar chain from its energy balance (no
+//! measured accelerations): the energy of a spring-free chain is linear in
+//! a small set of base parameters, and so is the friction power, so over a
+//! window `[t_a, t_b]`
+//!
+//! `theta' (phi_E(t_b) - phi_E(t_a)) + theta_F' int phi_F dt = int tau' qd dt`
+//!
+//! is one linear equation in the parameters, estimated by recursive least
+//! squares with forgetting.
+//!
+//! Base parameters ([`BaseParameters`]), with absolute link angles
+//! `phi = L q` and speeds `w = L qd`:
+//! - `A_jl` (`j <= l`): the link inertia amplitudes, `T_links = 1/2 sum_jl
+//!   A_jl cos(phi_j - phi_l) w_j w_l`;
+//! - `G_j`: the gravity amplitudes, `V = sum_j G_j (1 - cos phi_j)`;
+//! - `Ir_j`: rotor inertias (gear ratios known), `T_rotors = 1/2 sum_j Ir_j
+//!   (sum_{i<j} qd_i - gr_j qd_j)^2`;
+//! - `b_j`, `cf_j`: viscous and Coulomb friction, power `b qd^2 + cf qd
+//!   atan(k qd)` (the sharpness `k` known).
+//!
+//! Masses, lengths, centres of mass and inertias are not identifiable
+//! separately (only these combinations act on the motion);
+//! [`BaseParameters::chain_params`] maps an estimate back to a physical chain
+//! that has exactly these base parameters.
+//! Directions the motion does not excite receive no information: a window
+//! whose regressor carries too little is skipped, and the covariance is
+//! bounded, so the estimate there stays at the prior.
+
+use crate::mechanics::{PlanarChain, PlanarChainParams, Vector};
+use nalgebra::{SMatrix, SVector};
+
+/// Number of base parameters of an `N`-joint chain: `N (N + 1) / 2`
+/// inertia amplitudes, `N` gravity amplitudes, `N` rotor inertias, `2 N`
+/// friction coefficients.
+pub const fn base_parameter_count(n: usize) -> usize {
+    n * (n + 1) / 2 + 4 * n
+}
+
+/// Why a chain cannot be identified or an estimate not mapped back.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum IdentifyError {
+    /// The energy is not linear in the base parameters with springs.
+    #[error("identification needs a chain without joint springs (k{0} = {1})")]
+    Spring(usize, f64),
+    /// The estimate is not a physical chain.
+    #[error("the estimate is not a physical chain: {0}")]
+    NotPhysical(String),
+}
+
+/// The base parameters of an `N`-joint chain (`NP` =
+/// [`base_parameter_count`]`(N)`), in the order `A_jl` (row by row, `j <=
+/// l`), `G_j`, `Ir_j`, `b_j`, `cf_j`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BaseParameters<const N: usize, const NP: usize> {
+    /// The parameter vector.
+    pub theta: SVector<f64, NP>,
+}
+
+impl<const N: usize, const NP: usize> BaseParameters<N, NP> {
+    const CHECK: () = assert!(
+        NP == base_parameter_count(N),
+        "NP must be base_parameter_count(N)"
+    );
+
+    /// Index of `A_jl`, upper triangle row by row.
+    fn a_index(j: usize, l: usize) -> usize {
+        let (j, l) = (j.min(l), j.max(l));
+        // rows 0..j hold N, N - 1, ..., N - j + 1 entries
+        j * N - j * j.saturating_sub(1) / 2 + (l - j)
+    }
+
+    const fn g_index(j: usize) -> usize {
+        N * (N + 1) / 2 + j
+    }
+
+    const fn rotor_index(j: usize) -> usize {
+        N * (N + 1) / 2 + N + j
+    }
+
+    const fn viscous_index(j: usize) -> usize {
+        N * (N + 1) / 2 + 2 * N + j
+    }
+
+    const fn coulomb_index(j: usize) -> usize {
+        N * (N + 1) / 2 + 3 * N + j
+    }
+
+    /// The base parameters of a chain (refused: joint springs).
+    pub fn of(params: &PlanarChainParams<N>) -> Result<Self, IdentifyError> {
+        let () = Self::CHECK;
+        if let Some((j, joint)) = params
+            .joints
+            .iter()
+            .enumerate()
+            .find(|(_, joint)| joint.stiffness != 0.0)
+        {
+            return Err(IdentifyError::Spring(j + 1, joint.stiffness));
+        }
+        let links = &params.links;
+        let carried = |j: usize| -> f64 { links[j + 1..].iter().map(|l| l.mass).sum() };
+        let mut theta = SVector::<f64, NP>::zeros();
+        for j in 0..N {
+            let lj = &links[j];
+            // A_jj: the link's inertia about its joint plus what it carries at its tip.
+            theta[Self::a_index(j, j)] =
+                lj.inertia_about_joint() + lj.length * lj.length * carried(j);
+            for l in j + 1..N {
+                let ll = &links[l];
+                theta[Self::a_index(j, l)] =
+                    lj.length * (ll.mass * ll.com + ll.length * carried(l));
+            }
+            theta[Self::g_index(j)] = params.gravity * (lj.mass * lj.com + lj.length * carried(j));
+            let joint = &params.joints[j];
+            theta[Self::rotor_index(j)] = joint.rotor_inertia;
+            theta[Self::viscous_index(j)] = joint.viscous;
+            theta[Self::coulomb_index(j)] = joint.coulomb;
+        }
+        Ok(Self { theta })
+    }
+
+    /// A physical chain with exactly these base parameters: the lengths
+    /// `l_j = A_jl / (G_l / g)` (least squares over `l > j`; the last link's
+    /// from `prior`), the lightest masses that have them (each link's
+    /// inertia about its centre of mass zero: equivalent point masses; the
+    /// prior's mass for a link whose centre of mass is at its joint), gear
+    /// ratios, gravity and the Coulomb sharpness of `prior`.
+    pub fn chain_params(
+        &self,
+        prior: &PlanarChainParams<N>,
+    ) -> Result<PlanarChainParams<N>, IdentifyError> {
+        let theta = &self.theta;
+        if !theta.iter().all(|v| v.is_finite()) {
+            return Err(IdentifyError::NotPhysical("non-finite estimate".into()));
+        }
+        let g = prior.gravity;
+        let mut out = *prior;
+        for j in 0..N {
+            if j + 1 < N {
+                let (num, den) = (j + 1..N).fold((0.0, 0.0), |(n, d), l| {
+                    let gl = theta[Self::g_index(l)] / g;
+                    (n + theta[Self::a_index(j, l)] * gl, d + gl * gl)
+                });
+                if !(den > 0.0 && num > 0.0) {
+                    return Err(IdentifyError::NotPhysical(format!(
+                        "link {} length: A and G give {num} / {den}",
+                        j + 1
+                    )));
+                }
+                out.links[j].length = num / den;
+            }
+        }
+        for j in (0..N).rev() {
+            let carried: f64 = out.links[j + 1..].iter().map(|l| l.mass).sum();
+            let link = &mut out.links[j];
+            let first_moment = theta[Self::g_index(j)] / g - link.length * carried;
+            let about_joint = theta[Self::a_index(j, j)] - link.length * link.length * carried;
+            if about_joint.is_nan() || about_joint <= 0.0 {
+                return Err(IdentifyError::NotPhysical(format!(
+                    "link {} has inertia {about_joint} about its joint",
+                    j + 1
+                )));
+            }
+            // The lightest link with this first moment and inertia about
+            // the joint, m = (m r)^2 / I_joint (no inertia about its COM):
+            // every heavier choice of the carried masses can make an inner
+            // link's inertia about its joint negative.
+            if first_moment.abs() > 1e-12 * about_joint {
+                link.mass = first_moment * first_moment / about_joint;
+            }
+            link.com = first_moment / link.mass;
+            link.inertia = about_joint - link.mass * link.com * link.com;
+            let joint = &mut out.joints[j];
+            joint.rotor_inertia = theta[Self::rotor_index(j)];
+            joint.viscous = theta[Self::viscous_index(j)];
+            joint.coulomb = theta[Self::coulomb_index(j)];
+        }
+        PlanarChain::new(out).map_err(|e| IdentifyError::NotPhysical(e.to_string()))?;
+        Ok(out)
+    }
+}
+
+/// The energy features `phi_E(q, qd)`: `E = theta' phi_E` (friction entries 0).
+pub fn energy_features<const N: usize, const NP: usize>(
+    params: &PlanarChainParams<N>,
+    q: &Vector<N>,
+    qd: &Vector<N>,
+) -> SVector<f64, NP> {
+    type B<const N: usize, const NP: usize> = BaseParameters<N, NP>;
+    let mut phi_abs = Vector::<N>::zeros();
+    let mut w = Vector::<N>::zeros();
+    let (mut a, mut b) = (0.0, 0.0);
+    for j in 0..N {
+        a += q[j];
+        b += qd[j];
+        phi_abs[j] = a;
+        w[j] = b;
+    }
+    let mut f = SVector::<f64, NP>::zeros();
+    for j in 0..N {
+        f[B::<N, NP>::a_index(j, j)] = 0.5 * w[j] * w[j];
+        for l in j + 1..N {
+            f[B::<N, NP>::a_index(j, l)] = (phi_abs[j] - phi_abs[l]).cos() * w[j] * w[l];
+        }
+        f[B::<N, NP>::g_index(j)] = 1.0 - phi_abs[j].cos();
+        let before: f64 = qd.iter().take(j).sum();
+        let rotor = before - params.joints[j].gear_ratio * qd[j];
+        f[B::<N, NP>::rotor_index(j)] = 0.5 * rotor * rotor;
+    }
+    f
+}
+
+/// The friction power features `phi_F(qd)`: friction power `= theta'
+/// phi_F` (energy entries 0).
+pub fn friction_features<const N: usize, const NP: usize>(
+    params: &PlanarChainParams<N>,
+    qd: &Vector<N>,
+) -> SVector<f64, NP> {
+    type B<const N: usize, const NP: usize> = BaseParameters<N, NP>;
+    let mut f = SVector::<f64, NP>::zeros();
+    for j in 0..N {
+        f[B::<N, NP>::viscous_index(j)] = qd[j] * qd[j];
+        f[B::<N, NP>::coulomb_index(j)] = qd[j] * (params.coulomb_sharpness * qd[j]).atan();
+    }
+    f
+}
+
+/// Settings of the recursive least squares.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RlsOptions {
+    /// Forgetting factor per window, in (0, 1] (1: no forgetting).
+    pub forgetting: f64,
+    /// Prior standard deviation of each parameter, relative to its prior
+    /// value (absolute for a zero prior: `prior_floor`).
+    pub prior_relative: f64,
+    /// Prior standard deviation of a parameter whose prior is 0.
+    pub prior_floor: f64,
+    /// Samples per window.
+    pub window: usize,
+    /// Standard deviation of one window's equation error (J): integration
+    /// error of the work and friction integrals, measurement noise.
+    pub equation_noise: f64,
+    /// A window whose information `h' P h / equation_noise^2` is below this
+    /// is skipped (not exciting).
+    pub min_information: f64,
+}
+
+impl Default for RlsOptions {
+    fn default() -> Self {
+        Self {
+            forgetting: 0.995,
+            prior_relative: 0.5,
+            prior_floor: 0.05,
+            window: 20,
+            equation_noise: 1e-3,
+            min_information: 1e-4,
+        }
+    }
+}
+
+/// Energy-balance identification by recursive least squares, fed one
+/// sample at a time (measured `q`, `qd` and the torque applied over the
+/// previous sample); fixed size, no allocation.
+#[derive(Clone, Debug)]
+pub struct EnergyBalanceRls<const N: usize, const NP: usize> {
+    prior: PlanarChainParams<N>,
+    options: RlsOptions,
+    estimate: SVector<f64, NP>,
+    covariance: SMatrix<f64, NP, NP>,
+    /// Largest diagonal of the covariance: its prior (bounds windup).
+    covariance_bound: SVector<f64, NP>,
+    /// Window: features at its start, integrals so far, samples in it.
+    start: SVector<f64, NP>,
+    friction_integral: SVector<f64, NP>,
+    work_integral: f64,
+    samples: usize,
+    last: Option<(Vector<N>, Vector<N>, Vector<N>)>,
+    updates: usize,
+}
+
+impl<const N: usize, const NP: usize> EnergyBalanceRls<N, NP> {
+    /// Starts at the prior chain's base parameters.
+    pub fn new(prior: &PlanarChainParams<N>, options: RlsOptions) -> Result<Self, IdentifyError> {
+        let theta = BaseParameters::<N, NP>::of(prior)?.theta;
+        // In units of the equation noise: the RLS gain is then P h / (lambda + h' P h).
+        let noise2 = options.equation_noise.powi(2);
+        let variance = theta.map(|v| {
+            (options.prior_relative * v.abs())
+                .max(options.prior_floor)
+                .powi(2)
+                / noise2
+        });
+        Ok(Self {
+            prior: *prior,
+            options,
+            estimate: theta,
+            covariance: SMatrix::from_diagonal(&variance),
+            covariance_bound: variance,
+            start: SVector::zeros(),
+            friction_integral: SVector::zeros(),
+            work_integral: 0.0,
+            samples: 0,
+            last: None,
+            updates: 0,
+        })
+    }
+
+    /// The current estimate.
+    pub fn estimate(&self) -> BaseParameters<N, NP> {
+        BaseParameters {
+            theta: self.estimate,
+        }
+    }
+
+    /// Windows that updated the estimate so far.
+    pub fn updates(&self) -> usize {
+        self.updates
+    }
+
+    /// One sample: the state `(q, qd)` now and the torque `tau` applied
+    /// since the previous sample, `dt` seconds ago. Returns whether a
+    /// window closed and updated the estimate.
+    pub fn add_sample(&mut self, q: &Vector<N>, qd: &Vector<N>, tau: &Vector<N>, dt: f64) -> bool {
+        if !(q.iter().chain(qd).chain(tau).all(|v| v.is_finite()) && dt > 0.0) {
+            // A gap: start a new window at the next good sample.
+            self.last = None;
+            return false;
+        }
+        let Some((_, qd_prev, _)) = self.last else {
+            self.last = Some((*q, *qd, *tau));
+            self.start = energy_features::<N, NP>(&self.prior, q, qd);
+            self.friction_integral.fill(0.0);
+            self.work_integral = 0.0;
+            self.samples = 0;
+            return false;
+        };
+        // Trapezoid rule with the torque held over the sample.
+        let fp = friction_features::<N, NP>(&self.prior, &qd_prev);
+        let fc = friction_features::<N, NP>(&self.prior, qd);
+        self.friction_integral += (fp + fc) * (0.5 * dt);
+        self.work_integral += 0.5 * dt * tau.dot(&(qd_prev + qd));
+        self.samples += 1;
+        self.last = Some((*q, *qd, *tau));
+        if self.samples < self.options.window {
+            return false;
+        }
+        let end = energy_features::<N, NP>(&self.prior, q, qd);
+        let h = end - self.start + self.friction_integral;
+        let y = self.work_integral;
+        self.start = end;
+        self.friction_integral.fill(0.0);
+        self.work_integral = 0.0;
+        self.samples = 0;
+        self.update(&h, y)
+    }
+
+    fn update(&mut self, h: &SVector<f64, NP>, y: f64) -> bool {
+        let lambda = self.options.forgetting;
+        let ph = self.covariance * h;
+        let information = h.dot(&ph);
+        if !(information.is_finite() && information >= self.options.min_information) {
+            return false;
+        }
+        let gain = ph / (lambda + information);
+        let candidate = self.estimate + gain * (y - h.dot(&self.estimate));
+        if (BaseParameters::<N, NP> { theta: candidate })
+            .chain_params(&self.prior)
+            .is_err()
+        {
+            // Projection: an update leaving the physical set is refused.
+            return false;
+        }
+        self.estimate = candidate;
+        let mut p = (self.covariance - gain * ph.transpose()) / lambda;
+        // Bounded covariance: forgetting does not wind up directions that
+        // receive no information.
+        for i in 0..NP {
+            let bound = self.covariance_bound[i];
+            if p[(i, i)] > bound {
+                let s = (bound / p[(i, i)]).sqrt();
+                for k in 0..NP {
+                    p[(i, k)] *= s;
+                    p[(k, i)] *= s;
+                }
+            }
+        }
+        self.covariance = (p + p.transpose()) * 0.5;
+        self.updates += 1;
+        true
+    }
+}
