@@ -47,6 +47,26 @@ pub enum IdentifyError {
     NotPhysical(String),
 }
 
+/// Why an estimate is not a physical chain (allocation-free).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum Unphysical {
+    /// A non-finite parameter.
+    #[error("non-finite estimate")]
+    NonFinite,
+    /// The amplitudes give no positive length of this link (1-based).
+    #[error("no positive length of link {0}")]
+    Length(usize),
+    /// This link's inertia about its joint is not positive.
+    #[error("link {0} has no positive inertia about its joint")]
+    InertiaAboutJoint(usize),
+    /// This link's mass is not positive.
+    #[error("link {0} has no positive mass")]
+    Mass(usize),
+    /// A negative rotor inertia or friction coefficient at this joint.
+    #[error("negative rotor inertia or friction at joint {0}")]
+    Joint(usize),
+}
+
 /// The base parameters of an `N`-joint chain (`NP` =
 /// [`base_parameter_count`]`(N)`), in the order `A_jl` (row by row, `j <=
 /// l`), `G_j`, `Ir_j`, `b_j`, `cf_j`.
@@ -128,26 +148,37 @@ impl<const N: usize, const NP: usize> BaseParameters<N, NP> {
         &self,
         prior: &PlanarChainParams<N>,
     ) -> Result<PlanarChainParams<N>, IdentifyError> {
+        let out = self
+            .physical(prior)
+            .map_err(|u| IdentifyError::NotPhysical(u.to_string()))?;
+        PlanarChain::new(out).map_err(|e| IdentifyError::NotPhysical(e.to_string()))?;
+        Ok(out)
+    }
+
+    /// [`BaseParameters::chain_params`] without the chain's own checks and
+    /// without allocating (the projection of the per-sample estimate): the
+    /// lengths, inertias about the joints and masses positive, rotor
+    /// inertias and friction not negative (then the inertia is positive
+    /// definite: every link is a positive point mass).
+    pub fn physical(
+        &self,
+        prior: &PlanarChainParams<N>,
+    ) -> Result<PlanarChainParams<N>, Unphysical> {
         let theta = &self.theta;
         if !theta.iter().all(|v| v.is_finite()) {
-            return Err(IdentifyError::NotPhysical("non-finite estimate".into()));
+            return Err(Unphysical::NonFinite);
         }
         let g = prior.gravity;
         let mut out = *prior;
-        for j in 0..N {
-            if j + 1 < N {
-                let (num, den) = (j + 1..N).fold((0.0, 0.0), |(n, d), l| {
-                    let gl = theta[Self::g_index(l)] / g;
-                    (n + theta[Self::a_index(j, l)] * gl, d + gl * gl)
-                });
-                if !(den > 0.0 && num > 0.0) {
-                    return Err(IdentifyError::NotPhysical(format!(
-                        "link {} length: A and G give {num} / {den}",
-                        j + 1
-                    )));
-                }
-                out.links[j].length = num / den;
+        for j in 0..N.saturating_sub(1) {
+            let (num, den) = (j + 1..N).fold((0.0, 0.0), |(n, d), l| {
+                let gl = theta[Self::g_index(l)] / g;
+                (n + theta[Self::a_index(j, l)] * gl, d + gl * gl)
+            });
+            if !(den > 0.0 && num > 0.0) {
+                return Err(Unphysical::Length(j + 1));
             }
+            out.links[j].length = num / den;
         }
         for j in (0..N).rev() {
             let carried: f64 = out.links[j + 1..].iter().map(|l| l.mass).sum();
@@ -155,10 +186,7 @@ impl<const N: usize, const NP: usize> BaseParameters<N, NP> {
             let first_moment = theta[Self::g_index(j)] / g - link.length * carried;
             let about_joint = theta[Self::a_index(j, j)] - link.length * link.length * carried;
             if about_joint.is_nan() || about_joint <= 0.0 {
-                return Err(IdentifyError::NotPhysical(format!(
-                    "link {} has inertia {about_joint} about its joint",
-                    j + 1
-                )));
+                return Err(Unphysical::InertiaAboutJoint(j + 1));
             }
             // The lightest link with this first moment and inertia about
             // the joint, m = (m r)^2 / I_joint (no inertia about its COM):
@@ -167,14 +195,19 @@ impl<const N: usize, const NP: usize> BaseParameters<N, NP> {
             if first_moment.abs() > 1e-12 * about_joint {
                 link.mass = first_moment * first_moment / about_joint;
             }
+            if !(link.mass > 0.0 && link.mass.is_finite()) {
+                return Err(Unphysical::Mass(j + 1));
+            }
             link.com = first_moment / link.mass;
             link.inertia = about_joint - link.mass * link.com * link.com;
             let joint = &mut out.joints[j];
             joint.rotor_inertia = theta[Self::rotor_index(j)];
             joint.viscous = theta[Self::viscous_index(j)];
             joint.coulomb = theta[Self::coulomb_index(j)];
+            if joint.rotor_inertia < 0.0 || joint.viscous < 0.0 || joint.coulomb < 0.0 {
+                return Err(Unphysical::Joint(j + 1));
+            }
         }
-        PlanarChain::new(out).map_err(|e| IdentifyError::NotPhysical(e.to_string()))?;
         Ok(out)
     }
 }
@@ -247,7 +280,7 @@ pub struct RlsOptions {
 impl Default for RlsOptions {
     fn default() -> Self {
         Self {
-            forgetting: 0.995,
+            forgetting: 0.999,
             prior_relative: 0.5,
             prior_floor: 0.05,
             window: 20,
@@ -325,7 +358,7 @@ impl<const N: usize, const NP: usize> EnergyBalanceRls<N, NP> {
             self.last = None;
             return false;
         }
-        let Some((_, qd_prev, _)) = self.last else {
+        let Some((q_prev, qd_prev, _)) = self.last else {
             self.last = Some((*q, *qd, *tau));
             self.start = energy_features::<N, NP>(&self.prior, q, qd);
             self.friction_integral.fill(0.0);
@@ -333,11 +366,12 @@ impl<const N: usize, const NP: usize> EnergyBalanceRls<N, NP> {
             self.samples = 0;
             return false;
         };
-        // Trapezoid rule with the torque held over the sample.
+        // The torque is held over the sample: its work is exactly
+        // tau' (q - q_prev); the friction power by the trapezoid rule.
         let fp = friction_features::<N, NP>(&self.prior, &qd_prev);
         let fc = friction_features::<N, NP>(&self.prior, qd);
         self.friction_integral += (fp + fc) * (0.5 * dt);
-        self.work_integral += 0.5 * dt * tau.dot(&(qd_prev + qd));
+        self.work_integral += tau.dot(&(q - q_prev));
         self.samples += 1;
         self.last = Some((*q, *qd, *tau));
         if self.samples < self.options.window {
@@ -363,7 +397,7 @@ impl<const N: usize, const NP: usize> EnergyBalanceRls<N, NP> {
         let gain = ph / (lambda + information);
         let candidate = self.estimate + gain * (y - h.dot(&self.estimate));
         if (BaseParameters::<N, NP> { theta: candidate })
-            .chain_params(&self.prior)
+            .physical(&self.prior)
             .is_err()
         {
             // Projection: an update leaving the physical set is refused.

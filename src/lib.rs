@@ -14,6 +14,7 @@
 //!   energy, the polynomial mode chart `X(s)` and its family over energy;
 //! - [`mpc`]: the EigenMPC controller (real-time iterations).
 
+pub mod adapt;
 pub mod identify;
 pub mod integrate;
 pub mod mechanics;

@@ -196,13 +196,16 @@ impl<const N: usize> Default for PlanarChain<N> {
     }
 }
 
-fn check(name: String, value: f64, positive: bool) -> Result<(), ParamsError> {
+/// Checks a parameter; its `name` is only made for the error, so that
+/// building a valid chain allocates nothing (online identification rebuilds
+/// chains in a real-time path).
+fn check(name: impl FnOnce() -> String, value: f64, positive: bool) -> Result<(), ParamsError> {
     let ok = value.is_finite() && if positive { value > 0.0 } else { value >= 0.0 };
     if ok {
         Ok(())
     } else {
         Err(ParamsError::Invalid {
-            name,
+            name: name(),
             value,
             reason: if positive {
                 "must be finite and > 0"
@@ -219,8 +222,8 @@ impl<const N: usize> PlanarChain<N> {
     pub fn new(params: PlanarChainParams<N>) -> Result<Self, ParamsError> {
         for (j, link) in params.links.iter().enumerate() {
             let n = j + 1;
-            check(format!("m{n}"), link.mass, true)?;
-            check(format!("l{n}"), link.length, true)?;
+            check(|| format!("m{n}"), link.mass, true)?;
+            check(|| format!("l{n}"), link.length, true)?;
             if !link.com.is_finite() {
                 return Err(ParamsError::Invalid {
                     name: format!("r{n}"),
@@ -242,11 +245,11 @@ impl<const N: usize> PlanarChain<N> {
         }
         for (j, joint) in params.joints.iter().enumerate() {
             let n = j + 1;
-            check(format!("Ir{n}"), joint.rotor_inertia, false)?;
-            check(format!("gr{n}"), joint.gear_ratio, true)?;
-            check(format!("b{n}"), joint.viscous, false)?;
-            check(format!("cf{n}"), joint.coulomb, false)?;
-            check(format!("k{n}"), joint.stiffness, false)?;
+            check(|| format!("Ir{n}"), joint.rotor_inertia, false)?;
+            check(|| format!("gr{n}"), joint.gear_ratio, true)?;
+            check(|| format!("b{n}"), joint.viscous, false)?;
+            check(|| format!("cf{n}"), joint.coulomb, false)?;
+            check(|| format!("k{n}"), joint.stiffness, false)?;
             if !joint.rest_angle.is_finite() {
                 return Err(ParamsError::Invalid {
                     name: format!("q_rest{n}"),
@@ -255,8 +258,12 @@ impl<const N: usize> PlanarChain<N> {
                 });
             }
         }
-        check("g".into(), params.gravity, false)?;
-        check("coulomb_sharpness".into(), params.coulomb_sharpness, true)?;
+        check(|| "g".into(), params.gravity, false)?;
+        check(
+            || "coulomb_sharpness".into(),
+            params.coulomb_sharpness,
+            true,
+        )?;
 
         let links = &params.links;
         // Lever arm of link j's length or COM in the position of link i's COM.

@@ -331,6 +331,8 @@ impl<const N: usize> ChartFamily<N> {
             }
         }
         chart.degree = self.degree;
+        chart.eigenvector = self.eigenvector;
+        chart.equilibrium = self.equilibrium;
         chart.max_residual = self.residuals[i].max(self.residuals[i + 1]);
     }
 }

@@ -168,6 +168,45 @@ where
         Ok(controller)
     }
 
+    /// Replaces the controller's model (an identified one, say) and, for a
+    /// controller on a mode family, the family computed for it (same chart
+    /// degree); the plan is kept as the warm start. Returns the old family,
+    /// so that the caller can drop it outside a real-time path; nothing is
+    /// allocated here.
+    pub fn replace_model(
+        &mut self,
+        system: S,
+        family: Option<ChartFamily<N>>,
+    ) -> Result<Option<ChartFamily<N>>, MpcError> {
+        match (&family, self.reference.chart()) {
+            (Some(f), Some(chart)) if f.degree() != chart.degree => {
+                return Err(MpcError::InvalidReference(format!(
+                    "the new family's charts have degree {}, the controller's {}",
+                    f.degree(),
+                    chart.degree
+                )));
+            }
+            (Some(_), None) => {
+                return Err(MpcError::InvalidReference(
+                    "a family needs a chart variant (curved, hybrid)".into(),
+                ));
+            }
+            (None, _) if self.family.is_some() => {
+                return Err(MpcError::InvalidReference(
+                    "a controller on a mode family needs the new model's family".into(),
+                ));
+            }
+            _ => {}
+        }
+        self.system = system;
+        let old = std::mem::replace(&mut self.family, family);
+        if let (Some(f), Some(chart)) = (&self.family, self.reference.chart_mut()) {
+            f.write_chart(self.config.cost.e_ref, chart);
+        }
+        self.prepared = false;
+        Ok(old)
+    }
+
     /// The mode family the chart follows, if any.
     pub fn family(&self) -> Option<&ChartFamily<N>> {
         self.family.as_ref()

@@ -1,0 +1,265 @@
+//! Online adaptation of a controller's model: the energy-balance
+//! identification ([`crate::identify`]) is fed every sample; when its
+//! estimate has moved, the new model and its eigenmode family are computed
+//! on a worker thread (tens of milliseconds: never inside a sample) and
+//! swapped into the controller at the first sample after they are ready.
+//!
+//! The per-sample path ([`Adaptation::sample`]) does not allocate and never
+//! waits: it feeds the identification, and at most once per `period`
+//! samples posts a request or takes a finished result through a mutex it
+//! only `try_lock`s. The family the controller drops is handed back to the
+//! worker, which frees it.
+
+use crate::identify::{BaseParameters, EnergyBalanceRls, IdentifyError, RlsOptions};
+use crate::mechanics::{PlanarChain, PlanarChainParams, Vector};
+use crate::modes::{ChartFamily, FamilyOptions};
+use crate::mpc::Controller;
+use nalgebra::SVector;
+use std::sync::{Arc, Condvar, Mutex};
+use std::thread::JoinHandle;
+
+/// When the model follows the estimate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AdaptOptions {
+    /// Samples between two looks at the estimate (>= 1).
+    pub period: usize,
+    /// Relative change of a base parameter (against its value in use plus
+    /// the identification's `prior_floor`) that triggers a new model.
+    pub min_change: f64,
+    /// Identification settings.
+    pub rls: RlsOptions,
+    /// Offline simulation: wait for the worker's model at the next look
+    /// (deterministic closed loops whatever the machine's speed). Never for
+    /// a real-time loop.
+    pub synchronous: bool,
+}
+
+impl Default for AdaptOptions {
+    fn default() -> Self {
+        Self {
+            period: 40,
+            min_change: 1e-2,
+            rls: RlsOptions::default(),
+            synchronous: false,
+        }
+    }
+}
+
+/// A request to the worker: the model's parameters and its family's options.
+struct Request<const N: usize> {
+    params: PlanarChainParams<N>,
+    family: FamilyOptions,
+    mode_index: usize,
+}
+
+/// What the worker and the sample path share.
+struct Slot<const N: usize> {
+    request: Option<Request<N>>,
+    /// The worker's answer (Err: the model or its family failed).
+    result: Option<Result<(PlanarChain<N>, ChartFamily<N>), ()>>,
+    /// A family the controller no longer uses, for the worker to free.
+    garbage: Option<ChartFamily<N>>,
+    quit: bool,
+}
+
+/// Identification plus model updates of one controller on an `N`-joint
+/// chain (`NX = 2 N`, `NP` = [`crate::identify::base_parameter_count`]`(N)`).
+pub struct Adaptation<const N: usize, const NX: usize, const NP: usize> {
+    prior: PlanarChainParams<N>,
+    options: AdaptOptions,
+    rls: EnergyBalanceRls<N, NP>,
+    /// Base parameters of the model the controller has.
+    in_use: SVector<f64, NP>,
+    /// Base parameters of the model the worker is computing.
+    posted: SVector<f64, NP>,
+    pending: bool,
+    /// Requests whose model or family could not be computed.
+    failures: usize,
+    samples: usize,
+    updates: usize,
+    shared: Arc<(Mutex<Slot<N>>, Condvar)>,
+    worker: Option<JoinHandle<()>>,
+}
+
+impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
+    /// Starts from the controller's model `prior` (gear ratios, gravity and
+    /// the Coulomb sharpness are taken as known) and its worker thread.
+    pub fn new(prior: &PlanarChainParams<N>, options: AdaptOptions) -> Result<Self, IdentifyError> {
+        let rls = EnergyBalanceRls::new(prior, options.rls)?;
+        let in_use = BaseParameters::<N, NP>::of(prior)?.theta;
+        let shared = Arc::new((
+            Mutex::new(Slot {
+                request: None,
+                result: None,
+                garbage: None,
+                quit: false,
+            }),
+            Condvar::new(),
+        ));
+        let for_worker = Arc::clone(&shared);
+        let worker = std::thread::Builder::new()
+            .name("eigenmpc-adapt".into())
+            .spawn(move || work::<N, NX>(&for_worker))
+            .map_err(|e| IdentifyError::NotPhysical(format!("no worker thread: {e}")))?;
+        Ok(Self {
+            prior: *prior,
+            options: AdaptOptions {
+                period: options.period.max(1),
+                ..options
+            },
+            rls,
+            in_use,
+            posted: in_use,
+            pending: false,
+            failures: 0,
+            samples: 0,
+            updates: 0,
+            shared,
+            worker: Some(worker),
+        })
+    }
+
+    /// The identification.
+    pub fn identification(&self) -> &EnergyBalanceRls<N, NP> {
+        &self.rls
+    }
+
+    /// Models swapped into the controller so far.
+    pub fn model_updates(&self) -> usize {
+        self.updates
+    }
+
+    /// Estimates whose model or mode family could not be computed (the
+    /// controller kept its model).
+    pub fn failed_models(&self) -> usize {
+        self.failures
+    }
+
+    /// One sample, before the controller's step: `(q, qd)` measured now,
+    /// `tau` the torque applied since the previous sample, `dt` ago. Feeds
+    /// the identification; swaps a ready model and family into
+    /// `controller`; posts a new one when the estimate has moved.
+    pub fn sample(
+        &mut self,
+        controller: &mut Controller<PlanarChain<N>, N, NX>,
+        q: &Vector<N>,
+        qd: &Vector<N>,
+        tau: &Vector<N>,
+        dt: f64,
+    ) {
+        self.rls.add_sample(q, qd, tau, dt);
+        self.samples += 1;
+        if !self.samples.is_multiple_of(self.options.period) {
+            return;
+        }
+        let (lock, wake) = &*self.shared;
+        let mut slot = if self.options.synchronous {
+            let Ok(mut slot) = lock.lock() else { return };
+            while self.pending && slot.result.is_none() {
+                slot = match wake.wait(slot) {
+                    Ok(s) => s,
+                    Err(_) => return,
+                };
+            }
+            slot
+        } else {
+            // Never wait in a real-time sample: a busy worker is looked at
+            // next period.
+            let Ok(slot) = lock.try_lock() else { return };
+            slot
+        };
+        if let Some(result) = slot.result.take() {
+            self.pending = false;
+            // A failed model or family (or one this controller cannot
+            // take) leaves the model in use; a later estimate may succeed.
+            match result.map(|(model, family)| controller.replace_model(model, Some(family))) {
+                Ok(Ok(old)) => {
+                    slot.garbage = old;
+                    self.in_use = self.posted;
+                    self.updates += 1;
+                    wake.notify_one();
+                }
+                _ => self.failures += 1,
+            }
+        }
+        if self.pending {
+            return;
+        }
+        let estimate = self.rls.estimate();
+        // Relative change per parameter (a friction coefficient near zero
+        // against the prior's floor).
+        let floor = self.options.rls.prior_floor;
+        let change = (0..NP)
+            .map(|i| (estimate.theta[i] - self.in_use[i]).abs() / (self.in_use[i].abs() + floor))
+            .fold(0.0, f64::max);
+        if change < self.options.min_change {
+            return;
+        }
+        let Ok(params) = estimate.physical(&self.prior) else {
+            return;
+        };
+        let Some(family) = controller.family() else {
+            return;
+        };
+        let Ok(chain) = PlanarChain::new(params) else {
+            return;
+        };
+        let mut options = FamilyOptions::for_system(&chain, &[controller.config().cost.e_ref]);
+        options.degree = family.degree();
+        slot.request = Some(Request {
+            params,
+            family: options,
+            mode_index: family.mode_index(),
+        });
+        self.posted = estimate.theta;
+        self.pending = true;
+        wake.notify_one();
+    }
+}
+
+impl<const N: usize, const NX: usize, const NP: usize> Drop for Adaptation<N, NX, NP> {
+    fn drop(&mut self) {
+        let (lock, wake) = &*self.shared;
+        if let Ok(mut slot) = lock.lock() {
+            slot.quit = true;
+        }
+        wake.notify_one();
+        if let Some(worker) = self.worker.take() {
+            let _ = worker.join();
+        }
+    }
+}
+
+/// The worker: computes requested models and families, frees garbage.
+fn work<const N: usize, const NX: usize>(shared: &(Mutex<Slot<N>>, Condvar)) {
+    let (lock, wake) = shared;
+    let Ok(mut slot) = lock.lock() else { return };
+    loop {
+        drop(slot.garbage.take());
+        if slot.quit {
+            return;
+        }
+        if let Some(request) = slot.request.take() {
+            drop(slot);
+            let computed = PlanarChain::new(request.params)
+                .ok()
+                .and_then(|model| {
+                    ChartFamily::compute::<_, NX>(&model, request.mode_index, &request.family)
+                        .ok()
+                        .map(|family| (model, family))
+                })
+                .ok_or(());
+            slot = match lock.lock() {
+                Ok(s) => s,
+                Err(_) => return,
+            };
+            slot.result = Some(computed);
+            wake.notify_all();
+            continue;
+        }
+        slot = match wake.wait(slot) {
+            Ok(s) => s,
+            Err(_) => return,
+        };
+    }
+}
