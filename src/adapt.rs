@@ -13,7 +13,7 @@
 use crate::identify::{BaseParameters, EnergyBalanceRls, IdentifyError, RlsOptions};
 use crate::mechanics::{PlanarChain, PlanarChainParams, Vector};
 use crate::modes::{ChartFamily, FamilyOptions};
-use crate::mpc::Controller;
+use crate::mpc::{Controller, prediction_substeps};
 use nalgebra::SVector;
 use std::sync::{Arc, Condvar, Mutex};
 use std::thread::JoinHandle;
@@ -26,6 +26,9 @@ pub struct AdaptOptions {
     /// Relative change of a base parameter (against its value in use plus
     /// the identification's `prior_floor`) that triggers a new model.
     pub min_change: f64,
+    /// Top of a new model's mode family (J); `<= 0`: the default of
+    /// [`FamilyOptions::for_system`] for the new model.
+    pub family_energy_max: f64,
     /// Identification settings.
     pub rls: RlsOptions,
     /// Offline simulation: wait for the worker's model at the next look
@@ -39,24 +42,31 @@ impl Default for AdaptOptions {
         Self {
             period: 40,
             min_change: 1e-2,
+            family_energy_max: -1.0,
             rls: RlsOptions::default(),
             synchronous: false,
         }
     }
 }
 
-/// A request to the worker: the model's parameters and its family's options.
+/// A request to the worker: the model's parameters and, for a controller
+/// on a mode family, the family's options and mode.
 struct Request<const N: usize> {
     params: PlanarChainParams<N>,
-    family: FamilyOptions,
-    mode_index: usize,
+    family: Option<(FamilyOptions, usize)>,
+    /// The controller's shooting interval (for the prediction substeps).
+    dt: f64,
 }
+
+/// The worker's answer: the model, its family (None: the controller has
+/// none) and the prediction substeps its friction needs.
+type Computed<const N: usize> = (PlanarChain<N>, Option<ChartFamily<N>>, usize);
 
 /// What the worker and the sample path share.
 struct Slot<const N: usize> {
     request: Option<Request<N>>,
     /// The worker's answer (Err: the model or its family failed).
-    result: Option<Result<(PlanarChain<N>, ChartFamily<N>), ()>>,
+    result: Option<Result<Computed<N>, ()>>,
     /// A family the controller no longer uses, for the worker to free.
     garbage: Option<ChartFamily<N>>,
     quit: bool,
@@ -124,6 +134,12 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
         &self.rls
     }
 
+    /// Drops the identification's open window (see
+    /// [`EnergyBalanceRls::restart_window`]).
+    pub fn restart_window(&mut self) {
+        self.rls.restart_window();
+    }
+
     /// Models swapped into the controller so far.
     pub fn model_updates(&self) -> usize {
         self.updates
@@ -172,8 +188,14 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
             self.pending = false;
             // A failed model or family (or one this controller cannot
             // take) leaves the model in use; a later estimate may succeed.
-            match result.map(|(model, family)| controller.replace_model(model, Some(family))) {
+            let replaced = result.map(|(model, family, substeps)| {
+                let old = controller.replace_model(model, family)?;
+                controller.set_substeps(substeps).map(|()| old)
+            });
+            match replaced {
                 Ok(Ok(old)) => {
+                    // Empty here: the worker frees the garbage before it
+                    // computes the next result, so this never drops a family.
                     slot.garbage = old;
                     self.in_use = self.posted;
                     self.updates += 1;
@@ -198,18 +220,25 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
         let Ok(params) = estimate.physical(&self.prior) else {
             return;
         };
-        let Some(family) = controller.family() else {
-            return;
+        let family = match controller.family() {
+            Some(family) => {
+                let Ok(chain) = PlanarChain::new(params) else {
+                    return;
+                };
+                let mut options = if self.options.family_energy_max > 0.0 {
+                    FamilyOptions::up_to(self.options.family_energy_max)
+                } else {
+                    FamilyOptions::for_system(&chain, &[controller.config().cost.e_ref])
+                };
+                options.degree = family.degree();
+                Some((options, family.mode_index()))
+            }
+            None => None,
         };
-        let Ok(chain) = PlanarChain::new(params) else {
-            return;
-        };
-        let mut options = FamilyOptions::for_system(&chain, &[controller.config().cost.e_ref]);
-        options.degree = family.degree();
         slot.request = Some(Request {
             params,
-            family: options,
-            mode_index: family.mode_index(),
+            family,
+            dt: controller.config().dt,
         });
         self.posted = estimate.theta;
         self.pending = true;
@@ -244,9 +273,17 @@ fn work<const N: usize, const NX: usize>(shared: &(Mutex<Slot<N>>, Condvar)) {
             let computed = PlanarChain::new(request.params)
                 .ok()
                 .and_then(|model| {
-                    ChartFamily::compute::<_, NX>(&model, request.mode_index, &request.family)
-                        .ok()
-                        .map(|family| (model, family))
+                    // Other friction may need other prediction substeps
+                    // (an eigenvalue problem: here, not in the sample).
+                    let substeps = prediction_substeps(&model, request.dt);
+                    match &request.family {
+                        None => Some((model, None, substeps)),
+                        Some((options, mode)) => {
+                            ChartFamily::compute::<_, NX>(&model, *mode, options)
+                                .ok()
+                                .map(|family| (model, Some(family), substeps))
+                        }
+                    }
                 })
                 .ok_or(());
             slot = match lock.lock() {

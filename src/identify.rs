@@ -105,6 +105,33 @@ impl<const N: usize, const NP: usize> BaseParameters<N, NP> {
         N * (N + 1) / 2 + 3 * N + j
     }
 
+    /// `A_jl` (0-based joints, either order): the link inertia amplitude
+    /// (kg m^2).
+    pub fn inertia_amplitude(&self, j: usize, l: usize) -> f64 {
+        self.theta[Self::a_index(j, l)]
+    }
+
+    /// `G_j` (0-based): the gravity amplitude (N m).
+    pub fn gravity_amplitude(&self, j: usize) -> f64 {
+        self.theta[Self::g_index(j)]
+    }
+
+    /// `Ir_j` (0-based): the motor's rotor inertia before the gearbox
+    /// (kg m^2, as [`crate::mechanics::Joint::rotor_inertia`]).
+    pub fn rotor_inertia(&self, j: usize) -> f64 {
+        self.theta[Self::rotor_index(j)]
+    }
+
+    /// `b_j` (0-based): the viscous friction (N m s).
+    pub fn viscous(&self, j: usize) -> f64 {
+        self.theta[Self::viscous_index(j)]
+    }
+
+    /// `cf_j` (0-based): the Coulomb friction (N m).
+    pub fn coulomb(&self, j: usize) -> f64 {
+        self.theta[Self::coulomb_index(j)]
+    }
+
     /// The base parameters of a chain (refused: joint springs).
     pub fn of(params: &PlanarChainParams<N>) -> Result<Self, IdentifyError> {
         let () = Self::CHECK;
@@ -342,6 +369,12 @@ impl<const N: usize, const NP: usize> EnergyBalanceRls<N, NP> {
         BaseParameters {
             theta: self.estimate,
         }
+    }
+
+    /// Drops the open window (a gap in the measurements, a restart): the
+    /// next sample starts a new one. The estimate is kept.
+    pub fn restart_window(&mut self) {
+        self.last = None;
     }
 
     /// Windows that updated the estimate so far.

@@ -12,7 +12,11 @@
 //! - [`integrate`]: RK4 with sensitivities and adaptive Dormand-Prince 5(4);
 //! - [`modes`]: linear modes, nonlinear eigenmodes (brake orbits) continued in
 //!   energy, the polynomial mode chart `X(s)` and its family over energy;
-//! - [`mpc`]: the EigenMPC controller (real-time iterations).
+//! - [`mpc`]: the EigenMPC controller (real-time iterations);
+//! - [`identify`], [`adapt`]: online identification of the robot from its
+//!   energy balance, and the controller's model following it;
+//! - [`robustness`]: closed loops with noise, delay, a sluggish motor and a
+//!   plant that is not the model.
 
 pub mod adapt;
 pub mod identify;
@@ -22,3 +26,4 @@ pub mod model_file;
 pub mod modes;
 pub mod mpc;
 pub mod qp;
+pub mod robustness;

@@ -24,8 +24,9 @@ use crate::STATUS_BAD_ARGUMENT;
 use eigenmpc::mpc::{ControlStatus, CostParams, Variant};
 use eigenmpc_fmu_models::chain::ChainParameters;
 use eigenmpc_fmu_models::controller::ControllerProduct;
+use eigenmpc_fmu_models::controller::adaptive::AdaptiveController;
 use eigenmpc_fmu_models::controller::named::settings_from_named;
-use eigenmpc_fmu_models::controller::settings::{ChainController, ChartSource, Settings, Tuning};
+use eigenmpc_fmu_models::controller::settings::{ChartSource, Settings, Tuning};
 use eigenmpc_fmu_models::enums::{CHART_SOURCE, QP_SOLVER, VARIANT};
 use eigenmpc_fmu_models::products::{EigenMpc2, EigenMpc3};
 use nalgebra::SVector;
@@ -85,6 +86,16 @@ pub struct EigenMpcConfig {
     /// Computed curved reference: top of the family's energy range (J);
     /// <= 0: max(half the upright potential, 1.25 E_ref).
     pub family_energy_max: f64,
+    /// Online adaptation (1) of the model to the identified robot, or none
+    /// (0, default): as the FMU's `adapt`.
+    pub adapt: i32,
+    /// Adaptation: time between two looks at the estimate (s), as the FMU's
+    /// `adapt_period`.
+    pub adapt_period: f64,
+    /// Adaptation: 1 = a step never waits for the worker thread's new
+    /// model (real-time loops); 0 (default) = the next look waits for it
+    /// (reproducible offline runs). As the FMU's `adapt_realtime`.
+    pub adapt_realtime: i32,
 }
 
 /// Diagnostics of the last [`eigenmpc_step`].
@@ -99,11 +110,15 @@ pub struct EigenMpcStepInfo {
     pub solve_time: f64,
     /// Energy of the step's state under the controller's model (J).
     pub energy: f64,
+    /// Models taken from the identification so far (0 without adaptation).
+    pub model_updates: u32,
 }
 
 /// The controller behind a handle, whatever its number of joints.
 trait JointController: Send {
     fn joints(&self) -> usize;
+    /// The base parameters (estimate with adaptation), or None.
+    fn estimate(&self, out: &mut [f64]) -> Option<usize>;
     /// One sample; `state` has `2 joints`, `tau` `joints` elements.
     fn step(&mut self, state: &[f64], tau: &mut [f64]) -> EigenMpcStepInfo;
     fn set_cost(&mut self, cost: CostParams) -> Result<(), String>;
@@ -111,38 +126,53 @@ trait JointController: Send {
     fn reset(&mut self);
 }
 
-impl<const N: usize, const NX: usize> JointController for ChainController<N, NX> {
+impl<const N: usize, const NX: usize, const NP: usize> JointController
+    for AdaptiveController<N, NX, NP>
+{
     fn joints(&self) -> usize {
         N
     }
 
+    fn estimate(&self, out: &mut [f64]) -> Option<usize> {
+        let theta = AdaptiveController::estimate(self)?.theta;
+        let n = out.len().min(NP);
+        out[..n].copy_from_slice(&theta.as_slice()[..n]);
+        Some(NP)
+    }
+
     fn step(&mut self, state: &[f64], tau: &mut [f64]) -> EigenMpcStepInfo {
         let z = SVector::<f64, NX>::from_column_slice(state);
-        let out = self.step(&z);
+        let dt = self.controller().config().dt;
+        let out = AdaptiveController::step(self, &z, dt);
         tau.copy_from_slice(out.tau.as_slice());
         let energy = if matches!(out.status, ControlStatus::InvalidState) {
             f64::NAN
         } else {
-            self.energy(&z)
+            self.controller().energy(&z)
         };
         EigenMpcStepInfo {
             status: out.status.code(),
             qp_iterations: u32::try_from(out.qp_iterations).unwrap_or(u32::MAX),
             solve_time: out.preparation_time + out.feedback_time,
             energy,
+            model_updates: u32::try_from(self.model_updates()).unwrap_or(u32::MAX),
         }
     }
 
     fn set_cost(&mut self, cost: CostParams) -> Result<(), String> {
-        ChainController::set_cost(self, cost).map_err(|e| e.to_string())
+        self.controller_mut()
+            .set_cost(cost)
+            .map_err(|e| e.to_string())
     }
 
     fn set_e_ref(&mut self, e_ref: f64) -> Result<(), String> {
-        ChainController::set_e_ref(self, e_ref).map_err(|e| e.to_string())
+        self.controller_mut()
+            .set_e_ref(e_ref)
+            .map_err(|e| e.to_string())
     }
 
     fn reset(&mut self) {
-        ChainController::reset(self);
+        AdaptiveController::reset(self);
     }
 }
 
@@ -181,9 +211,20 @@ fn settings_from(config: &EigenMpcConfig) -> Result<Settings<2>, String> {
             m => return Err(format!("mode = {m} must be 1 (in-phase) or 2 (anti-phase)")),
         },
         family_energy_max: config.family_energy_max,
+        adapt: c_bool("adapt", config.adapt)?,
+        adapt_period: config.adapt_period,
+        adapt_realtime: c_bool("adapt_realtime", config.adapt_realtime)?,
         // what the config does not hold: the FMU's defaults (the 14 J chart, ...)
         ..EigenMpc2::settings(variant)
     })
+}
+
+/// A C boolean field: 0 or 1.
+fn c_bool(name: &str, v: i32) -> Result<bool, String> {
+    match v {
+        0 | 1 => Ok(v == 1),
+        _ => Err(format!("{name} = {v} must be 0 or 1")),
+    }
 }
 
 fn tuning_from(config: &EigenMpcConfig) -> Tuning {
@@ -242,6 +283,9 @@ pub extern "C" fn eigenmpc_config_default(variant: i32) -> EigenMpcConfig {
         chart_source: CHART_SOURCE.item(s.chart_source),
         mode: s.mode as i32 + 1,
         family_energy_max: s.family_energy_max,
+        adapt: i32::from(s.adapt),
+        adapt_period: s.adapt_period,
+        adapt_realtime: i32::from(s.adapt_realtime),
     }
 }
 
@@ -286,15 +330,18 @@ pub unsafe extern "C" fn eigenmpc_create(
                 row.copy_from_slice(&coef[j * CHART_COEFFICIENTS..(j + 1) * CHART_COEFFICIENTS]);
             }
         }
-        handle::<2, 4>(&settings)
+        handle::<2, 4, 11>(&settings)
     }));
     // SAFETY: the caller's guarantee on `error`.
     unsafe { finish_create("eigenmpc_create", result, error, error_len) }
 }
 
 /// A handle for the controller `settings` define.
-fn handle<const N: usize, const NX: usize>(settings: &Settings<N>) -> Result<EigenMpc, String> {
-    let controller: Box<dyn JointController> = Box::new(settings.build::<NX>()?);
+fn handle<const N: usize, const NX: usize, const NP: usize>(
+    settings: &Settings<N>,
+) -> Result<EigenMpc, String> {
+    let controller: Box<dyn JointController> =
+        Box::new(AdaptiveController::<N, NX, NP>::new(settings)?);
     Ok(EigenMpc {
         controller,
         variant: settings.variant,
@@ -369,8 +416,8 @@ pub unsafe extern "C" fn eigenmpc_create_named(
             pairs.push((name, value));
         }
         match joints {
-            2 => handle::<2, 4>(&settings_from_named::<EigenMpc2, 2>(&pairs)?),
-            3 => handle::<3, 6>(&settings_from_named::<EigenMpc3, 3>(&pairs)?),
+            2 => handle::<2, 4, 11>(&settings_from_named::<EigenMpc2, 2>(&pairs)?),
+            3 => handle::<3, 6, 18>(&settings_from_named::<EigenMpc3, 3>(&pairs)?),
             n => Err(format!("joints = {n}: 2 or 3 are available")),
         }
     }));
@@ -506,8 +553,44 @@ pub unsafe extern "C" fn eigenmpc_last_step(
     }
 }
 
-/// Forgets the plan: the next step starts afresh (solved to convergence).
-/// Returns 0, or `EIGENMPC_STATUS_BAD_ARGUMENT` for a NULL handle.
+/// The controller's base parameters, in the order of the FMU's outputs
+/// `estimate.A[j,l]` (j <= l, row by row), `estimate.G[j]`,
+/// `estimate.Ir[j]`, `estimate.b[j]`, `estimate.cf[j]`: the
+/// identification's estimate with `adapt`, else the model's. Writes at
+/// most `len` of them to `out` and returns how many there are (11 for 2
+/// joints, 18 for 3; call with `len` = 0 to ask), or
+/// `EIGENMPC_STATUS_BAD_ARGUMENT` (NULL pointer with `len` > 0, or a model
+/// with joint springs, which has none).
+///
+/// # Safety
+/// `mpc` is NULL or a live handle; `out` is NULL or points to `len`
+/// writable doubles.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn eigenmpc_estimate(mpc: *mut EigenMpc, out: *mut f64, len: usize) -> i32 {
+    // SAFETY: forwarded caller guarantees.
+    unsafe {
+        with_handle(mpc, |h| {
+            if out.is_null() && len > 0 {
+                return h.fail("eigenmpc_estimate: out is NULL".into());
+            }
+            let out = if len == 0 {
+                &mut [][..]
+            } else {
+                std::slice::from_raw_parts_mut(out, len)
+            };
+            match h.controller.estimate(out) {
+                Some(n) => n as i32,
+                None => h.fail(
+                    "eigenmpc_estimate: a model with joint springs has no base parameters".into(),
+                ),
+            }
+        })
+    }
+}
+
+/// Forgets the plan: the next step starts afresh (solved to convergence);
+/// with adaptation also the identification's open window (the estimate and
+/// the adapted model are kept). Returns 0, or `EIGENMPC_STATUS_BAD_ARGUMENT` for a NULL handle.
 ///
 /// # Safety
 /// `mpc` is NULL or a live handle.

@@ -51,7 +51,21 @@ impl Fmu {
 
     /// Instantiated, parameters and initial state set, initialized.
     fn start(params: &[(u32, f64)], integers: &[(u32, i32)], z0: [f64; 4]) -> Self {
+        Self::start_with(params, integers, &[], z0)
+    }
+
+    /// [`Fmu::start`] with Boolean parameters too.
+    fn start_with(
+        params: &[(u32, f64)],
+        integers: &[(u32, i32)],
+        booleans: &[(u32, bool)],
+        z0: [f64; 4],
+    ) -> Self {
         let fmu = Self::instantiate();
+        for &(vr, v) in booleans {
+            let v = ffi::fmi2Boolean::from(v);
+            assert_eq!(unsafe { fmi2SetBoolean(fmu.c, &vr, 1, &v) }, OK);
+        }
         for &(vr, v) in params {
             assert_eq!(fmu.set(&[vr], &[v]), OK, "{:?}", fmu.instance.log.lines());
         }
@@ -804,4 +818,196 @@ fn checked_in_model_description_matches_the_table() {
         "{} is out of date with the variable table: run `cargo run -p fmu-build` and commit it",
         path.display()
     );
+}
+
+/// `adapt` on: the FMU runs the library's adaptation (identification fed
+/// with the measured state and the torque it output, a new model and family
+/// at every look that found the estimate moved), sample for sample, on a
+/// plant it does not know; the estimate and the model count are outputs.
+/// Off (the default), the estimate outputs are the model's own.
+#[test]
+fn adapt_follows_the_identified_plant_like_the_library() {
+    use eigenmpc::adapt::Adaptation;
+    use eigenmpc::identify::BaseParameters;
+    use eigenmpc::integrate::{Dopri5, Tolerances};
+    use eigenmpc::mechanics::{PlanarChain, PlanarChainParams, state_derivative};
+
+    let estimate_vrs: Vec<u32> = EigenMpcFmu::description()
+        .variables
+        .iter()
+        .filter(|v| v.name.starts_with("estimate."))
+        .map(|v| v.value_reference)
+        .collect();
+    assert_eq!(estimate_vrs.len(), 11);
+    let read_estimate =
+        |fmu: &Fmu| -> Vec<f64> { estimate_vrs.iter().map(|&vr| fmu.real(vr)).collect() };
+
+    // Off: the outputs are the paper's pendulum's base parameters.
+    let off = Fmu::start(&[], &[], Z0);
+    let prior = PlanarChainParams::<2>::default();
+    let base = BaseParameters::<2, 11>::of(&prior).unwrap();
+    assert_eq!(read_estimate(&off), base.theta.as_slice());
+    assert_eq!(off.integer(vref("model_updates")), 0);
+    drop(off);
+
+    let mut fmu = Fmu::start_with(&[], &[], &[(vref("adapt"), true)], Z0);
+
+    let mut settings = EigenMpc2::settings(Variant::Curved);
+    settings.adapt = true;
+    let mut native = settings.build::<4>().unwrap();
+    let mut adaptation = Adaptation::<2, 4, 11>::new(&prior, settings.adapt_options()).unwrap();
+    let mut plant_params = PlanarChainParams::<2>::point_masses([1.0, 1.2], [1.1, 1.0], 9.81);
+    plant_params.joints[0].viscous = 0.05;
+    plant_params.joints[1].viscous = 0.05;
+    let plant = PlanarChain::new(plant_params).unwrap();
+    let tol = Tolerances {
+        rtol: 1e-10,
+        atol: 1e-10,
+    };
+    let mut ode = Dopri5::new(0.0, SVector::<f64, 4>::from(Z0), tol);
+    let mut tau = Vector::<2>::zeros();
+    for k in 0..(12.0 / DT) as usize {
+        let z = *ode.state();
+        let (q, qd) = (Vector::<2>::new(z[0], z[1]), Vector::<2>::new(z[2], z[3]));
+        adaptation.sample(&mut native, &q, &qd, &tau, DT);
+        tau = native.step(&z).tau;
+        // a solve at t_k takes the inputs set before fmi2DoStep(t_k, h)
+        // (t_0: at initialization)
+        if k > 0 {
+            assert_eq!(fmu.set(&state(), z.as_slice()), OK);
+        }
+        assert_eq!(fmu.step(DT), OK);
+        assert_eq!(fmu.tau(), [tau[0], tau[1]], "sample {k}");
+        ode.advance_to(
+            |_, z| state_derivative::<_, 2, 4>(&plant, z, &tau),
+            (k + 1) as f64 * DT,
+        )
+        .unwrap();
+    }
+    assert!(adaptation.model_updates() > 0);
+    assert_eq!(
+        fmu.integer(vref("model_updates")),
+        adaptation.model_updates() as i32
+    );
+    let estimate = adaptation.identification().estimate();
+    assert_eq!(read_estimate(&fmu), estimate.theta.as_slice());
+    // the estimate moved towards the plant's (G[2] = g m2 l2: +20 %)
+    let truth = BaseParameters::<2, 11>::of(&plant_params).unwrap();
+    let g2 = |b: &BaseParameters<2, 11>| b.gravity_amplitude(1);
+    assert!(
+        (g2(&estimate) - g2(&truth)).abs() < 0.5 * (g2(&base) - g2(&truth)).abs(),
+        "G[2]: estimate {}, model {}, plant {}",
+        g2(&estimate),
+        g2(&base),
+        g2(&truth)
+    );
+    // the chart range output follows the new family
+    let family = native.family().unwrap().energy_range();
+    assert_eq!(fmu.real(vref("chart_energy_max")), family.1);
+}
+
+/// A model with joint springs cannot be identified: `adapt` is refused at
+/// initialization with the reason.
+#[test]
+fn adapt_refuses_a_model_with_springs() {
+    let fmu = Fmu::instantiate();
+    let on: ffi::fmi2Boolean = 1;
+    assert_eq!(unsafe { fmi2SetBoolean(fmu.c, &vref("adapt"), 1, &on) }, OK);
+    assert_eq!(fmu.set(&[vref("k[1]")], &[2.0]), OK);
+    unsafe {
+        assert_eq!(fmi2SetupExperiment(fmu.c, 0, 0.0, 0.0, 0, 0.0), OK);
+        assert_eq!(fmi2EnterInitializationMode(fmu.c), OK);
+        assert_eq!(fmi2ExitInitializationMode(fmu.c), ERROR);
+    }
+    let log = format!("{:?}", fmu.instance.log.lines());
+    assert!(
+        log.contains("adapt = true") && log.contains("springs"),
+        "{log}"
+    );
+}
+
+/// The C API adapts as the FMU does: `adapt` in the config (checked) or
+/// by name; `eigenmpc_estimate` gives the base parameters in the FMU's
+/// output order, the model count is in the step info.
+#[test]
+fn c_api_adapts_and_reports_the_estimate() {
+    use eigenmpc::identify::BaseParameters;
+    use eigenmpc::mechanics::PlanarChainParams;
+    let mut err = [0 as std::ffi::c_char; 300];
+    let mut cfg = eigenmpc_config_default(VARIANT_CURVED);
+    assert_eq!(
+        (cfg.adapt, cfg.adapt_period, cfg.adapt_realtime),
+        (0, 1.0, 0)
+    );
+    cfg.adapt = 2;
+    let bad = unsafe { eigenmpc_create(&cfg, ptr::null(), err.as_mut_ptr(), err.len()) };
+    assert!(bad.is_null());
+    let text = unsafe { CStr::from_ptr(err.as_ptr()) }.to_str().unwrap();
+    assert!(text.contains("adapt = 2 must be 0 or 1"), "{text}");
+
+    // off: the model's base parameters
+    cfg.adapt = 0;
+    let off = unsafe { eigenmpc_create(&cfg, ptr::null(), err.as_mut_ptr(), err.len()) };
+    assert!(!off.is_null());
+    assert_eq!(unsafe { eigenmpc_estimate(off, ptr::null_mut(), 0) }, 11);
+    let mut theta = [f64::NAN; 11];
+    assert_eq!(
+        unsafe { eigenmpc_estimate(off, theta.as_mut_ptr(), 11) },
+        11
+    );
+    let prior = BaseParameters::<2, 11>::of(&PlanarChainParams::default()).unwrap();
+    assert_eq!(theta.as_slice(), prior.theta.as_slice());
+    assert_eq!(
+        unsafe { eigenmpc_estimate(off, ptr::null_mut(), 3) },
+        STATUS_BAD_ARGUMENT
+    );
+    unsafe { eigenmpc_free(off) };
+
+    // on, against the FMU's own adaptive controller on the same states
+    cfg.adapt = 1;
+    let on = unsafe { eigenmpc_create(&cfg, ptr::null(), err.as_mut_ptr(), err.len()) };
+    assert!(!on.is_null());
+    let mut settings = EigenMpc2::settings(Variant::Curved);
+    settings.adapt = true;
+    let mut native =
+        eigenmpc_fmu_models::controller::adaptive::AdaptiveController::<2, 4, 11>::new(&settings)
+            .unwrap();
+    // a plant with m2 20 % heavier than the model's: the estimate moves
+    let plant = eigenmpc::mechanics::PlanarChain::new(PlanarChainParams::point_masses(
+        [1.0, 1.2],
+        [1.0, 1.0],
+        9.81,
+    ))
+    .unwrap();
+    let tol = eigenmpc::integrate::Tolerances {
+        rtol: 1e-10,
+        atol: 1e-10,
+    };
+    let mut ode = eigenmpc::integrate::Dopri5::new(0.0, SVector::<f64, 4>::from(Z0), tol);
+    for k in 0..(6.0 / DT) as usize {
+        let z = *ode.state();
+        let mut tau = [f64::NAN; 2];
+        assert_eq!(
+            unsafe { eigenmpc_step(on, z.as_ptr(), tau.as_mut_ptr()) },
+            0
+        );
+        let expected = native.step(&z, DT).tau;
+        assert_eq!(tau.as_slice(), expected.as_slice(), "sample {k}");
+        let tau = Vector::<2>::from(tau);
+        ode.advance_to(
+            |_, z| eigenmpc::mechanics::state_derivative::<_, 2, 4>(&plant, z, &tau),
+            (k + 1) as f64 * DT,
+        )
+        .unwrap();
+    }
+    let mut info = EigenMpcStepInfo::default();
+    assert_eq!(unsafe { eigenmpc_last_step(on, &mut info) }, 0);
+    assert_eq!(info.model_updates as usize, native.model_updates());
+    assert_eq!(unsafe { eigenmpc_estimate(on, theta.as_mut_ptr(), 11) }, 11);
+    assert_eq!(
+        theta.as_slice(),
+        native.estimate().unwrap().theta.as_slice()
+    );
+    assert_ne!(theta.as_slice(), prior.theta.as_slice());
+    unsafe { eigenmpc_free(on) };
 }

@@ -173,6 +173,7 @@ fn c_api_step_does_not_allocate() {
             qp_iterations: 0,
             solve_time: 0.0,
             energy: f64::NAN,
+            model_updates: 0,
         };
         for k in 0..SAMPLES {
             let ((status, last), n) = counted(|| {
@@ -187,6 +188,40 @@ fn c_api_step_does_not_allocate() {
             z = plant_step(&z, tau);
         }
         assert!(info.energy > 1.0, "energy {} J", info.energy);
+        eigenmpc_free(mpc);
+    }
+}
+
+/// With `adapt` (real-time: never waiting for the worker), the steps that
+/// feed the identification, post a new model and swap it in allocate
+/// nothing either: the worker thread builds the model and its family.
+#[test]
+fn c_api_step_with_adaptation_does_not_allocate() {
+    let mut config = eigenmpc_config_default(VARIANT_CURVED);
+    config.adapt = 1;
+    config.adapt_realtime = 1;
+    config.adapt_period = 0.25;
+    // a plant the model does not know: 10 % longer links
+    let plant = eigenmpc::mechanics::PlanarChain::new(
+        eigenmpc::mechanics::PlanarChainParams::point_masses([1.0, 1.0], [1.1, 1.1], 9.81),
+    )
+    .unwrap();
+    let mut z = SVector::<f64, 4>::new(1.0, 0.5, 0.0, 0.0);
+    unsafe {
+        let mpc = eigenmpc_create(&config, ptr::null(), ptr::null_mut(), 0);
+        assert!(!mpc.is_null());
+        let mut tau = [f64::NAN; 2];
+        let mut info = EigenMpcStepInfo::default();
+        for k in 0..2000 {
+            let (status, n) = counted(|| eigenmpc_step(mpc, z.as_ptr(), tau.as_mut_ptr()));
+            assert!(status >= 0, "sample {k}");
+            assert_eq!(n, 0, "sample {k}: {n} allocations in eigenmpc_step");
+            z = rk4_step::<_, 2, 4>(&plant, &z, &Vector::<2>::from(tau), 0.025);
+            // the worker gets time to compute, as in real time
+            std::thread::sleep(std::time::Duration::from_micros(200));
+        }
+        assert_eq!(eigenmpc_last_step(mpc, &mut info), 0);
+        assert!(info.model_updates > 0, "a model was swapped in");
         eigenmpc_free(mpc);
     }
 }

@@ -36,6 +36,10 @@ pub enum Shape {
     /// One per joint and power, `name[j,k]`, `j = 1..=n`, `k = 0..K`; value
     /// reference `first + K (j - 1) + k`.
     JointPowers(usize),
+    /// One per pair of joints `j <= l` (upper triangle), `name[j,l]`, both
+    /// 1-based; element `(j, k = l)`, value reference `first` + row-major
+    /// position in the triangle.
+    JointPairs,
 }
 
 impl Shape {
@@ -45,6 +49,7 @@ impl Shape {
             Shape::Scalar => 1,
             Shape::Joints => n,
             Shape::JointPowers(k) => n * k,
+            Shape::JointPairs => n * (n + 1) / 2,
         }
     }
 
@@ -56,15 +61,20 @@ impl Shape {
             Shape::JointPowers(powers) => (0..n)
                 .flat_map(|j| (0..powers).map(move |k| Element { j, k }))
                 .collect(),
+            Shape::JointPairs => (0..n)
+                .flat_map(|j| (j..n).map(move |k| Element { j, k }))
+                .collect(),
         }
     }
 
-    /// Offset of `e` from the row's first value reference.
-    pub fn offset(self, e: Element) -> usize {
+    /// Offset of `e` from the row's first value reference (`n` joints).
+    pub fn offset(self, n: usize, e: Element) -> usize {
         match self {
             Shape::Scalar => 0,
             Shape::Joints => e.j,
             Shape::JointPowers(powers) => powers * e.j + e.k,
+            // Rows 0..j of the triangle hold n, n - 1, ..., n - j + 1 entries.
+            Shape::JointPairs => e.j * n - e.j * e.j.saturating_sub(1) / 2 + (e.k - e.j),
         }
     }
 }
@@ -74,7 +84,8 @@ impl Shape {
 pub struct Element {
     /// Joint index, 0-based (`name[j + 1]`).
     pub j: usize,
-    /// Power (only [`Shape::JointPowers`]).
+    /// Power ([`Shape::JointPowers`]) or second joint, 0-based
+    /// ([`Shape::JointPairs`]).
     pub k: usize,
 }
 
@@ -87,6 +98,8 @@ pub enum Kind {
     Integer,
     /// An enumeration (travels as `fmi2Integer`); its items bound the value.
     Enumeration(EnumerationType),
+    /// `fmi2Boolean`.
+    Boolean,
 }
 
 impl Kind {
@@ -94,6 +107,7 @@ impl Kind {
         match self {
             Kind::Real => BaseType::Real,
             Kind::Integer | Kind::Enumeration(_) => BaseType::Integer,
+            Kind::Boolean => BaseType::Boolean,
         }
     }
 }
@@ -115,6 +129,13 @@ pub enum Field<S> {
         /// Writes element `e` into the settings.
         set: fn(&mut S, Element, i32),
     },
+    /// A Boolean parameter.
+    Boolean {
+        /// Reads element `e` from the settings.
+        get: fn(&S, Element) -> bool,
+        /// Writes element `e` into the settings.
+        set: fn(&mut S, Element, bool),
+    },
 }
 
 impl<S> Field<S> {
@@ -128,10 +149,16 @@ impl<S> Field<S> {
         Field::Integer { get, set }
     }
 
+    /// A Boolean field.
+    pub fn boolean(get: fn(&S, Element) -> bool, set: fn(&mut S, Element, bool)) -> Self {
+        Field::Boolean { get, set }
+    }
+
     fn get(&self, s: &S, e: Element) -> Value {
         match self {
             Field::Real { get, .. } => Value::Real(get(s, e)),
             Field::Integer { get, .. } => Value::Integer(get(s, e)),
+            Field::Boolean { get, .. } => Value::Boolean(get(s, e)),
         }
     }
 
@@ -139,6 +166,7 @@ impl<S> Field<S> {
         match (self, v) {
             (Field::Real { set, .. }, Value::Real(x)) => set(s, e, x),
             (Field::Integer { set, .. }, Value::Integer(i)) => set(s, e, i),
+            (Field::Boolean { set, .. }, Value::Boolean(b)) => set(s, e, b),
             // The plumbing stores values of the row's own type only.
             _ => {}
         }
@@ -241,6 +269,11 @@ impl<S> Row<S> {
     /// An Integer row.
     pub fn integer(name: &'static str, shape: Shape) -> Self {
         Self::new(name, shape, Kind::Integer)
+    }
+
+    /// A Boolean row.
+    pub fn boolean(name: &'static str, shape: Shape) -> Self {
+        Self::new(name, shape, Kind::Boolean)
     }
 
     /// An enumeration row; its range is the items' range.
@@ -357,6 +390,7 @@ impl<S> Row<S> {
             Shape::Scalar => self.name.to_string(),
             Shape::Joints => format!("{}[{}]", self.name, e.j + 1),
             Shape::JointPowers(_) => format!("{}[{},{}]", self.name, e.j + 1, e.k),
+            Shape::JointPairs => format!("{}[{},{}]", self.name, e.j + 1, e.k + 1),
         }
     }
 
@@ -366,6 +400,7 @@ impl<S> Row<S> {
             Shape::Scalar => self.name.to_string(),
             Shape::Joints => format!("{}[j]", self.name),
             Shape::JointPowers(_) => format!("{}[j,k]", self.name),
+            Shape::JointPairs => format!("{}[j,l]", self.name),
         }
     }
 
@@ -408,13 +443,14 @@ impl<S> Table<S> {
     /// Lays out the value references: per base type, consecutive in row
     /// order; a row with [`Row::at`] starts at that reference.
     pub fn new(n: usize, rows: Vec<Row<S>>) -> Self {
-        let mut next = [0u32; 2];
+        let mut next = [0u32; 3];
         let first = rows
             .iter()
             .map(|row| {
                 let slot = match row.kind.base() {
                     BaseType::Real => 0,
-                    _ => 1,
+                    BaseType::Integer => 1,
+                    BaseType::Boolean => 2,
                 };
                 let start = row.at.unwrap_or(next[slot]);
                 next[slot] = start + row.shape.len(n) as u32;
@@ -436,7 +472,7 @@ impl<S> Table<S> {
 
     /// Value reference of element `e` of row number `i`.
     pub fn vr_at(&self, i: usize, e: Element) -> u32 {
-        self.first[i] + self.rows[i].shape.offset(e) as u32
+        self.first[i] + self.rows[i].shape.offset(self.n, e) as u32
     }
 
     /// Value reference of element `e` of the row named `name`.
@@ -469,6 +505,7 @@ impl<S> Table<S> {
             Kind::Real => Variable::real(name, vr),
             Kind::Integer => Variable::integer(name, vr),
             Kind::Enumeration(t) => Variable::enumeration(name, vr, t.name.clone()),
+            Kind::Boolean => Variable::boolean(name, vr),
         };
         let start = row.start(defaults, e);
         v = match &row.role {
@@ -543,7 +580,8 @@ impl<S> Table<S> {
                 let vr = self.vr_at(i, e);
                 let v = match row.kind.base() {
                     BaseType::Real => Value::Real(values.real(vr)),
-                    _ => Value::Integer(values.integer(vr)),
+                    BaseType::Integer => Value::Integer(values.integer(vr)),
+                    BaseType::Boolean => Value::Boolean(values.boolean(vr)),
                 };
                 field.set(settings, e, v);
             }
@@ -594,7 +632,8 @@ impl<S> Table<S> {
             let base = c_identifier(row.name);
             let family = match row.kind.base() {
                 BaseType::Real => "Real",
-                _ => "Integer",
+                BaseType::Integer => "Integer",
+                BaseType::Boolean => "Boolean",
             };
             match row.shape {
                 Shape::JointPowers(powers) => {
@@ -624,6 +663,7 @@ impl<S> Table<S> {
                     for e in row.shape.elements(self.n) {
                         let suffix = match row.shape {
                             Shape::Scalar => String::new(),
+                            Shape::JointPairs => format!("_{}_{}", e.j + 1, e.k + 1),
                             _ if base.ends_with(|c: char| c.is_ascii_digit()) => {
                                 format!("_{}", e.j + 1)
                             }
@@ -659,19 +699,21 @@ impl<S> Table<S> {
             .enumerate()
             .map(|(i, row)| {
                 let elements = row.shape.elements(self.n);
-                let integer = row.kind.base() != BaseType::Real;
+                let prefix = match row.kind.base() {
+                    BaseType::Real => "",
+                    BaseType::Integer => "int ",
+                    BaseType::Boolean => "bool ",
+                };
                 let vrs = match row.shape {
-                    Shape::JointPowers(powers) => format!(
-                        "{}{} + {powers} (j-1) + k",
-                        if integer { "int " } else { "" },
-                        self.first[i]
-                    ),
+                    Shape::JointPowers(powers) => {
+                        format!("{prefix}{} + {powers} (j-1) + k", self.first[i])
+                    }
                     _ => {
                         let list: Vec<String> = elements
                             .iter()
                             .map(|&e| self.vr_at(i, e).to_string())
                             .collect();
-                        format!("{}{}", if integer { "int " } else { "" }, list.join(", "))
+                        format!("{prefix}{}", list.join(", "))
                     }
                 };
                 let causality = match (&row.role, &row.kind) {
@@ -928,6 +970,51 @@ mod tests {
                 ("a[2]".to_string(), Value::Real(2.5))
             ]
         );
+    }
+
+    /// Boolean rows get their own value references; a pair row is the
+    /// upper triangle, row by row.
+    #[test]
+    fn boolean_and_joint_pair_rows() {
+        #[derive(Default)]
+        struct B {
+            on: bool,
+        }
+        let t = Table::new(
+            3,
+            vec![
+                Row::<B>::real("x", Shape::Scalar).output(),
+                Row::<B>::real("A", Shape::JointPairs).output(),
+                Row::<B>::boolean("on", Shape::Scalar)
+                    .parameter(Field::boolean(|s, _| s.on, |s, _, v| s.on = v)),
+            ],
+        );
+        let pairs: Vec<(String, u32)> = Shape::JointPairs
+            .elements(3)
+            .into_iter()
+            .map(|e| (t.rows[1].element_name(e), t.vr_at(1, e)))
+            .collect();
+        let expected = [
+            ("A[1,1]", 1),
+            ("A[1,2]", 2),
+            ("A[1,3]", 3),
+            ("A[2,2]", 4),
+            ("A[2,3]", 5),
+            ("A[3,3]", 6),
+        ];
+        assert_eq!(pairs.len(), expected.len());
+        for ((name, vr), (n, v)) in pairs.iter().zip(expected) {
+            assert_eq!((name.as_str(), *vr), (n, v));
+        }
+        assert_eq!(t.vr("on", Element::default()), Some(0));
+        let v = t.variables(&B { on: true });
+        assert_eq!(v.last().unwrap().start, Some(Value::Boolean(true)));
+        let h = t.c_defines("X_", "X").unwrap();
+        assert!(h.contains("#define X_VR_A_2_3 5\n"), "{h}");
+        assert!(h.contains("Boolean value reference of on"), "{h}");
+        let md = markdown(&[("X", t.docs(&B::default()))]).unwrap();
+        assert!(md.contains("| `on` | bool 0 | parameter (fixed) |"), "{md}");
+        assert!(md.contains("| `A[j,l]` | 1, 2, 3, 4, 5, 6 |"), "{md}");
     }
 
     #[test]

@@ -96,7 +96,15 @@ fn the_two_joint_controller_keeps_the_original_value_references() {
     // then the state estimator
     assert_eq!(vr(&d, "state_estimator"), (BaseType::Integer, 7));
     assert_eq!(vr(&d, "acceleration_noise"), (BaseType::Real, 143));
-    assert_eq!(d.variables.len(), 24 + 20 + 5 + 17 + 6 + 4);
+    // then the adaptation: Booleans from 0, the estimate after the noise levels
+    assert_eq!(vr(&d, "adapt"), (BaseType::Boolean, 0));
+    assert_eq!(vr(&d, "adapt_realtime"), (BaseType::Boolean, 1));
+    assert_eq!(vr(&d, "adapt_period"), (BaseType::Real, 144));
+    assert_eq!(vr(&d, "estimate.A[1,1]"), (BaseType::Real, 145));
+    assert_eq!(vr(&d, "estimate.A[2,2]"), (BaseType::Real, 147));
+    assert_eq!(vr(&d, "estimate.cf[2]"), (BaseType::Real, 155));
+    assert_eq!(vr(&d, "model_updates"), (BaseType::Integer, 8));
+    assert_eq!(d.variables.len(), 24 + 20 + 5 + 17 + 6 + 4 + 3 + 11 + 1);
 }
 
 /// Every variable of the original `DoublePendulum.fmu` keeps its name and

@@ -207,6 +207,18 @@ where
         Ok(old)
     }
 
+    /// Sets the RK4 substeps per shooting interval (a new model with other
+    /// friction may need others: [`prediction_substeps`]); the next
+    /// preparation uses them. Allocation-free.
+    pub fn set_substeps(&mut self, substeps: usize) -> Result<(), MpcError> {
+        let mut config = self.config;
+        config.substeps = substeps;
+        config.validate()?;
+        self.config.substeps = substeps;
+        self.prepared = false;
+        Ok(())
+    }
+
     /// The mode family the chart follows, if any.
     pub fn family(&self) -> Option<&ChartFamily<N>> {
         self.family.as_ref()

@@ -142,6 +142,18 @@ int main(void) {
     CHECK(eigenmpc_step(mpc, z3, tau3) == EIGENMPC_STATUS_SOLVED);
     for (int j = 0; j < 3; j++) CHECK(isfinite(tau3[j]) && fabs(tau3[j]) <= 2.0);
     eigenmpc_free(mpc);
+    /* Online adaptation by name: the base parameters are readable. */
+    const char *adapt_names[] = {"adapt", "adapt_period"};
+    const double adapt_values[] = {1.0, 0.5};
+    mpc = eigenmpc_create_named(2, adapt_names, adapt_values, 2, err, sizeof err);
+    CHECK(mpc != NULL);
+    double z2[4] = {0.05, 0.05, 0.0, 0.0}, tau2[2], theta[11];
+    CHECK(eigenmpc_step(mpc, z2, tau2) >= 0);
+    CHECK(eigenmpc_estimate(mpc, NULL, 0) == 11);
+    CHECK(eigenmpc_estimate(mpc, theta, 11) == 11);
+    /* the paper's pendulum: A[1,1] = 2, G[2] = 9.81 (kg m^2, N m) */
+    CHECK(fabs(theta[0] - 2.0) < 1e-12 && fabs(theta[4] - 9.81) < 1e-12);
+    eigenmpc_free(mpc);
     const char *bad[] = {"mu[1]"};
     CHECK(eigenmpc_create_named(2, bad, values, 1, err, sizeof err) == NULL);
     CHECK(strstr(err, "mu[1] is not a variable") != NULL);

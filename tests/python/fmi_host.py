@@ -43,13 +43,16 @@ class Slave:
         self.time = 0.0
 
     def set_named(self, values: dict):
-        """Sets Real values, and Integer / Enumeration ones (start-value files hold both)."""
+        """Sets Real, Integer / Enumeration (start-value files hold both) and Boolean values."""
         reals = {n: v for n, v in values.items() if self.type[n] == "Real"}
-        integers = {n: int(v) for n, v in values.items() if self.type[n] != "Real"}
+        booleans = {n: bool(v) for n, v in values.items() if self.type[n] == "Boolean"}
+        integers = {n: int(v) for n, v in values.items() if self.type[n] in ("Integer", "Enumeration")}
         if reals:
             self.fmu.setReal([self.vr[n] for n in reals], list(reals.values()))
         if integers:
             self.fmu.setInteger([self.vr[n] for n in integers], list(integers.values()))
+        if booleans:
+            self.fmu.setBoolean([self.vr[n] for n in booleans], list(booleans.values()))
 
     def get(self, *names):
         return self.fmu.getReal([self.vr[n] for n in names])

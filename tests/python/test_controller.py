@@ -32,7 +32,12 @@ def test_model_description(controller_md):
     assert outputs == [
         "tau[1]", "tau[2]", "energy", "solve_time", "qp_iterations", "solver_status",
         "chart_energy", "chart_energy_min", "chart_energy_max",
+        "estimate.A[1,1]", "estimate.A[1,2]", "estimate.A[2,2]", "estimate.G[1]", "estimate.G[2]",
+        "estimate.Ir[1]", "estimate.Ir[2]", "estimate.b[1]", "estimate.b[2]",
+        "estimate.cf[1]", "estimate.cf[2]", "model_updates",
     ]
+    assert v["adapt"].type == "Boolean" and v["adapt"].start == "false"
+    assert v["adapt_realtime"].type == "Boolean" and v["adapt_period"].unit == "s"
     # step mode: a solve uses the inputs of the step's start, so inputs set
     # at a communication point do not change the outputs there
     assert all(u.dependencies == [] for u in controller_md.outputs)
@@ -52,17 +57,22 @@ def test_model_description(controller_md):
     assert all(x.description for x in controller_md.modelVariables)
 
 
-def co_simulate(controller_md, controller_dir, plant_md, plant_dir, seconds, changes=None, ctrl_start=None):
+def co_simulate(
+    controller_md, controller_dir, plant_md, plant_dir, seconds, changes=None, ctrl_start=None,
+    plant_start=None, outputs=(),
+):
     """Gauss-Seidel master: each 25 ms step the controller gets the plant's
     state, steps, and its torque drives the plant's step. Returns rows
     (t, q1, q2, qd1, qd2, tau1, tau2, plant energy, status) at the sample
-    times, as `eigenmpc simulate --csv`, and the wall time."""
+    times, as `eigenmpc simulate --csv`, and the wall time; with `outputs`
+    (controller output names), also their last values as a dict."""
     ctrl = Slave(controller_md, controller_dir, "controller")
     plant = Slave(plant_md, plant_dir, "plant")
     start = {"q[1]": Q0[0], "q[2]": Q0[1]}
     start.update(ctrl_start or {})
     ctrl.initialize(start)
-    plant.initialize({"q0[1]": Q0[0], "q0[2]": Q0[1]})
+    plant.initialize({"q0[1]": Q0[0], "q0[2]": Q0[1], **(plant_start or {})})
+    vr_energy = [plant.vr["energy"]]
     vr_state = [plant.vr[n] for n in STATE]
     vr_ctrl_state = [ctrl.vr[n] for n in STATE]
     vr_tau = [ctrl.vr["tau[1]"], ctrl.vr["tau[2]"]]
@@ -83,16 +93,19 @@ def co_simulate(controller_md, controller_dir, plant_md, plant_dir, seconds, cha
         ctrl.step(DT)
         tau = ctrl.fmu.getReal(vr_tau)
         (status,) = ctrl.fmu.getInteger(vr_status)
-        rows.append((t, *z, *tau, pendulum_energy(*z), status))
+        rows.append((t, *z, *tau, plant.fmu.getReal(vr_energy)[0], status))
         if k == steps:
             break
         plant.fmu.setReal(vr_plant_tau, tau)
         plant.step(DT)
     wall = time.perf_counter() - wall
+    last = {n: (ctrl.get(n)[0] if ctrl.type[n] == "Real" else ctrl.fmu.getInteger([ctrl.vr[n]])[0]) for n in outputs}
     ctrl.fmu.terminate()
     plant.fmu.terminate()
     ctrl.free()
     plant.free()
+    if outputs:
+        return np.array(rows), wall, last
     return np.array(rows), wall
 
 
@@ -333,3 +346,41 @@ def test_controller_and_plant_under_libcosim(controller_fmu, controller_md, plan
     assert np.all(rms < 0.03)
     assert np.all(rows[:, 7] == 0)  # every solve succeeded
     assert np.all(np.abs(ctrl_tau) <= 1.0 + 1e-12)
+
+
+# The robustness issue's plant: m2 +20 %, l1 +10 %, viscous damping 0.05 N m s
+# on both joints, none of it in the controller's model (the paper's pendulum).
+WRONG_PLANT = {"m[2]": 1.2, "l[1]": 1.1, "b[1]": 0.05, "b[2]": 0.05}
+
+
+def test_adapt_finds_the_plants_energy_and_mode(controller_md, controller_unzipped, plant_md, plant_unzipped):
+    """Done-when of the robustness issue under fmpy: with `adapt` the plant's
+    true energy is within 1 % of 14 J by 60 s, the torque is what the damping
+    takes, and the identified gravity amplitudes approach the plant's."""
+    runs = {}
+    for adapt in (False, True):
+        rows, wall, last = co_simulate(
+            controller_md, controller_unzipped, plant_md, plant_unzipped, 60.0,
+            ctrl_start={"adapt": adapt}, plant_start=WRONG_PLANT,
+            outputs=["model_updates", "estimate.G[1]", "estimate.G[2]", "estimate.b[1]"],
+        )
+        tail = rows[rows[:, 0] > 55.0 + 1e-9]
+        damping = np.sqrt(np.mean((0.05 * tail[:, 3:5]) ** 2, axis=0))
+        runs[adapt] = (rows, np.mean(tail[:, 7]), rms_torque(rows), damping, last, wall)
+    rows, energy, torque, damping, last, wall = runs[True]
+    FIGURES.append(
+        f"fmpy, adapt on, plant m2 +20 %, l1 +10 %, b 0.05 (60 s, wall {wall:.1f} s): mean E last 5 s "
+        f"{energy:.4f} J (adapt off: {runs[False][1]:.4f} J), RMS torque {torque[0]:.4f} / {torque[1]:.4f} "
+        f"N m vs damping {damping[0]:.4f} / {damping[1]:.4f}, {last['model_updates']} models, "
+        f"G = {last['estimate.G[1]']:.3f} / {last['estimate.G[2]']:.3f} N m (plant 23.740 / 11.772), "
+        f"b[1] = {last['estimate.b[1]']:.4f}"
+    )
+    assert np.all(np.abs(rows[rows[:, 0] >= 60.0 - 1e-9, 7] - 14.0) < 0.01 * 14.0)
+    assert abs(energy - 14.0) < 0.01 * 14.0
+    assert np.all(torque <= damping + 0.02)
+    assert last["model_updates"] > 0
+    # G[1] = g (m1 + m2) l1, G[2] = g m2 l2 of the plant: 23.740, 11.772 N m
+    assert abs(last["estimate.G[1]"] - 23.740) < 0.02 * 23.740
+    assert abs(last["estimate.G[2]"] - 11.772) < 0.02 * 11.772
+    # without adaptation the energy ends far off (the test can fail)
+    assert abs(runs[False][1] - 14.0) > 0.05 * 14.0

@@ -15,6 +15,7 @@
 //! call returns (`fmi2ExitInitializationMode` for the first solve) and is
 //! held until the next solve.
 
+pub mod adaptive;
 pub mod docs;
 pub mod named;
 pub mod settings;
@@ -23,6 +24,7 @@ pub mod table;
 pub mod timing;
 
 use crate::units;
+use adaptive::AdaptiveController;
 use eigenmpc::mpc::{ControlOutput, MpcConfig, Variant};
 use fmi2_slave::table::{Element, Table};
 use fmi2_slave::{Context, DefaultExperiment, Model, ModelDescription, ModelError, Values};
@@ -52,7 +54,7 @@ pub trait ControllerProduct<const N: usize>: 'static {
 }
 
 /// Value references the sample path reads and writes.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 struct Io<const N: usize> {
     q: [u32; N],
     qd: [u32; N],
@@ -62,10 +64,20 @@ struct Io<const N: usize> {
     qp_iterations: u32,
     solver_status: u32,
     chart_energy: [u32; 3],
+    /// The base-parameter outputs, in the estimate's order (`NP`).
+    estimate: Vec<u32>,
+    model_updates: u32,
 }
 
 impl<const N: usize> Io<N> {
     fn new(t: &Table<Settings<N>>) -> Result<Self, String> {
+        let mut estimate = vec![];
+        for name in table::ESTIMATE_ROWS {
+            let i = t.row_index(name).ok_or_else(|| format!("no row {name}"))?;
+            for e in t.rows[i].shape.elements(N) {
+                estimate.push(t.vr_at(i, e));
+            }
+        }
         let joints = |name| {
             t.joint_vrs::<N>(name)
                 .ok_or_else(|| format!("no row {name}"))
@@ -87,13 +99,20 @@ impl<const N: usize> Io<N> {
                 scalar("chart_energy_min")?,
                 scalar("chart_energy_max")?,
             ],
+            estimate,
+            model_updates: scalar("model_updates")?,
         })
     }
 }
 
-/// The EigenMPC controller FMU model for `N` joints (`NX = 2 N`).
-pub struct ControllerFmu<P, const N: usize, const NX: usize> {
-    controller: ChainController<N, NX>,
+/// The EigenMPC controller FMU model for `N` joints (`NX = 2 N`, `NP` =
+/// [`eigenmpc::identify::base_parameter_count`]`(N)` base parameters).
+pub struct ControllerFmu<P, const N: usize, const NX: usize, const NP: usize> {
+    controller: AdaptiveController<N, NX, NP>,
+    /// Time of the last solve (the adaptation's sample interval).
+    solved_at: f64,
+    /// Model updates already reported.
+    updates_reported: usize,
     settings: Settings<N>,
     table: Table<Settings<N>>,
     io: Io<N>,
@@ -126,8 +145,8 @@ pub fn description<P: ControllerProduct<N>, const N: usize>() -> ModelDescriptio
     }
 }
 
-impl<P: ControllerProduct<N> + Send, const N: usize, const NX: usize> Model
-    for ControllerFmu<P, N, NX>
+impl<P: ControllerProduct<N> + Send, const N: usize, const NX: usize, const NP: usize> Model
+    for ControllerFmu<P, N, NX, NP>
 {
     fn description() -> ModelDescription {
         description::<P, N>()
@@ -136,6 +155,12 @@ impl<P: ControllerProduct<N> + Send, const N: usize, const NX: usize> Model
     fn initialize(values: &mut Values, ctx: &Context) -> Result<Self, ModelError> {
         let table = table::table::<N>();
         let io = Io::new(&table).map_err(ModelError::Error)?;
+        if io.estimate.len() != NP {
+            return Err(ModelError::Error(format!(
+                "{} base-parameter outputs for NP = {NP}",
+                io.estimate.len()
+            )));
+        }
         let defaults = P::settings(Variant::Curved);
         let mut settings = defaults.clone();
         table.read(values, &mut settings, |_| true);
@@ -147,9 +172,11 @@ impl<P: ControllerProduct<N> + Send, const N: usize, const NX: usize> Model
                  takes the reference from the model; set chart_source = parameters to use them",
             );
         }
-        let controller = settings.build::<NX>().map_err(ModelError::Error)?;
+        let controller = AdaptiveController::new(&settings).map_err(ModelError::Error)?;
         let mut model = Self {
             controller,
+            solved_at: ctx.experiment.start_time,
+            updates_reported: 0,
             clock: SampleClock::new(ctx.experiment.start_time, settings.sample_period),
             settings,
             table,
@@ -185,6 +212,7 @@ impl<P: ControllerProduct<N> + Send, const N: usize, const NX: usize> Model
         let mut settings = self.settings.clone();
         self.table.read(values, &mut settings, |r| r.is_tunable());
         self.controller
+            .controller_mut()
             .set_cost(settings.tuning.cost(settings.variant))
             .map_err(|e| ModelError::Error(e.to_string()))?;
         let moved = settings.tuning.e_ref != self.settings.tuning.e_ref;
@@ -196,7 +224,7 @@ impl<P: ControllerProduct<N> + Send, const N: usize, const NX: usize> Model
     }
 }
 
-impl<P, const N: usize, const NX: usize> ControllerFmu<P, N, NX> {
+impl<P, const N: usize, const NX: usize, const NP: usize> ControllerFmu<P, N, NX, NP> {
     fn inputs(&self, values: &Values) -> SVector<f64, NX> {
         SVector::from_fn(|i, _| {
             if i < N {
@@ -210,21 +238,39 @@ impl<P, const N: usize, const NX: usize> ControllerFmu<P, N, NX> {
     /// Writes the chart-energy outputs and warns when `E_ref` is clamped to
     /// the computed family's range (set-up and tuning only: may allocate).
     fn report_chart(&self, values: &mut Values, ctx: &Context) {
-        let range = self.controller.family().map(|f| f.energy_range());
+        self.write_chart_energies(values);
+        if let Some(warning) = chart_clamp_warning(self.controller.controller()) {
+            ctx.log.notice(&warning);
+        }
+    }
+
+    /// The chart-energy outputs (allocation-free).
+    fn write_chart_energies(&self, values: &mut Values) {
+        let controller = self.controller.controller();
+        let range = controller.family().map(|f| f.energy_range());
         let (lo, hi) = range.unwrap_or((0.0, 0.0));
-        let used = self.controller.chart_energy().unwrap_or(0.0);
+        let used = controller.chart_energy().unwrap_or(0.0);
         for (vr, v) in self.io.chart_energy.iter().zip([used, lo, hi]) {
             values.set_real(*vr, v);
-        }
-        if let Some(warning) = chart_clamp_warning(&self.controller) {
-            ctx.log.notice(&warning);
         }
     }
 
     /// One controller sample with the current inputs; writes the outputs.
     fn solve(&mut self, values: &mut Values, t: f64, ctx: &Context) {
         let z = self.inputs(values);
-        let out = self.controller.step(&z);
+        // On the grid the interval is the sample period (t carries the
+        // master's rounding); the first solve has no previous sample, and
+        // one period is a harmless stand-in (the identification only
+        // starts its window there).
+        let period = self.settings.sample_period;
+        let elapsed = t - self.solved_at;
+        let dt = if elapsed <= 0.0 || (elapsed - period).abs() < 1e-6 * period {
+            period
+        } else {
+            elapsed
+        };
+        let out = self.controller.step(&z, dt);
+        self.solved_at = t;
         self.solved_state = z;
         if !out.status.is_ok() {
             // Failure path only: the message allocates.
@@ -234,8 +280,15 @@ impl<P, const N: usize, const NX: usize> ControllerFmu<P, N, NX> {
                 out.tau.as_slice()
             ));
         }
-        let energy = self.controller.energy(&z);
+        let energy = self.controller.controller().energy(&z);
         self.write_outputs(values, &out, energy);
+        let updates = self.controller.model_updates();
+        if updates != self.updates_reported {
+            // A new model and family: their chart range (no message, no
+            // allocation: the clamp is reported at set-up and tuning).
+            self.updates_reported = updates;
+            self.write_chart_energies(values);
+        }
     }
 
     fn write_outputs(&self, values: &mut Values, out: &ControlOutput<N>, energy: f64) {
@@ -249,10 +302,23 @@ impl<P, const N: usize, const NX: usize> ControllerFmu<P, N, NX> {
             i32::try_from(out.qp_iterations).unwrap_or(i32::MAX),
         );
         values.set_integer(self.io.solver_status, out.status.code());
+        let estimate = self.controller.estimate();
+        for (i, vr) in self.io.estimate.iter().enumerate() {
+            values.set_real(*vr, estimate.map_or(0.0, |p| p.theta[i]));
+        }
+        values.set_integer(
+            self.io.model_updates,
+            i32::try_from(self.controller.model_updates()).unwrap_or(i32::MAX),
+        );
     }
 
     /// The controller (diagnostics and tests).
     pub fn controller(&self) -> &ChainController<N, NX> {
+        self.controller.controller()
+    }
+
+    /// The controller with its adaptation.
+    pub fn adaptive(&self) -> &AdaptiveController<N, NX, NP> {
         &self.controller
     }
 

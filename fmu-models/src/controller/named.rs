@@ -12,7 +12,8 @@ use fmi2_slave::variables::{BaseType, Causality};
 
 /// The settings of product `P` with the parameters `(name, value)` set over
 /// its defaults, each checked as `fmi2SetReal` / `fmi2SetInteger` would
-/// check it (Integer and enumeration parameters take integral values).
+/// check it (Integer and enumeration parameters take integral values,
+/// Boolean ones 0 or 1).
 /// Refused, naming the variable: an unknown name, a variable that is not a
 /// parameter, a value out of range or not integral where it must be.
 pub fn settings_from_named<P: ControllerProduct<N>, const N: usize>(
@@ -32,6 +33,8 @@ pub fn settings_from_named<P: ControllerProduct<N>, const N: usize>(
         let base = v.var_type.base();
         let value = match base {
             BaseType::Real => Value::Real(x),
+            BaseType::Boolean if x == 0.0 || x == 1.0 => Value::Boolean(x == 1.0),
+            BaseType::Boolean => return Err(format!("{name} = {x} must be 0 or 1 (Boolean)")),
             _ if x.fract() == 0.0 && x.abs() <= i32::MAX as f64 => Value::Integer(x as i32),
             _ => return Err(format!("{name} = {x} must be an integer")),
         };
@@ -60,8 +63,10 @@ mod tests {
             ("chart_source", 2.0),
             ("variant", 1.0),
             ("E_ref", 3.0),
+            ("adapt", 1.0),
         ])
         .unwrap();
+        assert!(s.adapt);
         assert_eq!(s.model.mass, [1.0, 1.0, 0.5]);
         assert_eq!(s.model.joints[1].coulomb, 0.08);
         assert_eq!(s.chart_source, ChartSource::Parameters);
@@ -82,6 +87,7 @@ mod tests {
                 "m[1] = NaN is not a finite number",
             ),
             (vec![("tau_max", 0.0)], "tau_max = 0 is below its minimum"),
+            (vec![("adapt", 0.5)], "adapt = 0.5 must be 0 or 1"),
         ] {
             let e = settings_from_named::<EigenMpc2, 2>(&pairs).unwrap_err();
             assert!(e.contains(needle), "{e}");

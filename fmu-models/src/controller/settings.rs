@@ -3,6 +3,7 @@
 //! from its config struct), so both build the controller the same way.
 
 use crate::chain::{ChainParameters, HasChain};
+use eigenmpc::adapt::AdaptOptions;
 use eigenmpc::mechanics::{MechanicalSystem, PlanarChain, Vector};
 use eigenmpc::modes::{Chart, ChartFamily, FamilyOptions, linear_modes};
 use eigenmpc::mpc::{
@@ -132,6 +133,17 @@ pub struct Settings<const N: usize> {
     pub state_estimator: StateEstimator,
     /// Its noise levels (used with [`StateEstimator::Ekf`]).
     pub noise: EstimatorConfig,
+    /// Online identification of the model, which the model, its energy
+    /// and its mode family then follow ([`eigenmpc::adapt`]).
+    pub adapt: bool,
+    /// Time between two looks at the estimate (s): a new model is taken
+    /// or requested at most this often.
+    pub adapt_period: f64,
+    /// Real-time adaptation: a sample never waits for the worker thread's
+    /// new model (it is taken at the first look after it is ready, so the
+    /// closed loop depends on the machine's speed). Off: the next look
+    /// waits for it, and every run gives the same numbers.
+    pub adapt_realtime: bool,
 }
 
 impl<const N: usize> HasChain<N> for Settings<N> {
@@ -175,6 +187,19 @@ impl<const N: usize> Settings<N> {
                 speed_noise: 0.05,
                 acceleration_noise: 0.3,
             },
+            adapt: false,
+            adapt_period: 1.0,
+            adapt_realtime: false,
+        }
+    }
+
+    /// The adaptation's options (with [`Settings::adapt`]).
+    pub fn adapt_options(&self) -> AdaptOptions {
+        AdaptOptions {
+            period: ((self.adapt_period / self.sample_period).round() as usize).max(1),
+            family_energy_max: self.family_energy_max,
+            synchronous: !self.adapt_realtime,
+            ..AdaptOptions::default()
         }
     }
 

@@ -226,7 +226,85 @@ pub fn table<const N: usize>() -> Table<Settings<N>> {
     rows.extend(rigid_rows::<Settings<N>, N>("Controller model: "));
     rows.extend(computed_reference_rows::<N>());
     rows.extend(estimator_rows::<N>());
+    rows.extend(adaptation_rows::<N>());
     Table::new(N, rows)
+}
+
+/// Names of the estimated base-parameter rows, in the order of
+/// [`eigenmpc::identify::BaseParameters`]'s vector.
+pub const ESTIMATE_ROWS: [&str; 5] = [
+    "estimate.A",
+    "estimate.G",
+    "estimate.Ir",
+    "estimate.b",
+    "estimate.cf",
+];
+
+/// The rows of the online adaptation (`adapt`) and its estimate.
+fn adaptation_rows<const N: usize>() -> Vec<Rw<N>> {
+    let estimate = |name, shape, unit, what: &str| {
+        Rw::<N>::real(name, shape)
+            .discrete_output()
+            .unit(unit)
+            .describe(format!(
+                "{what}: the identification's estimate with adapt = true, else the \
+                 controller model's value (0 for a model with joint springs)"
+            ))
+            .summary(format!("{what} (estimate with adapt)"))
+    };
+    let [a, g, ir, b, cf] = ESTIMATE_ROWS;
+    vec![
+        Rw::<N>::boolean("adapt", Shape::Scalar)
+            .parameter(Field::boolean(|s, _| s.adapt, |s, _, v| s.adapt = v))
+            .describe(
+                "Online adaptation: identify the robot's base parameters (inertia and \
+                 gravity amplitudes, rotor inertias, viscous and Coulomb friction) from the \
+                 measured motion and the torque applied, by the energy balance; the model, its \
+                 energy and its mode family follow the estimate (new family computed on a \
+                 worker thread). Needs a model without joint springs",
+            ),
+        Rw::<N>::real("adapt_period", Shape::Scalar)
+            .parameter(Field::real(
+                |s, _| s.adapt_period,
+                |s, _, v| s.adapt_period = v,
+            ))
+            .unit("s")
+            .range(1e-4, 1e3)
+            .describe(
+                "Adaptation: time between two looks at the estimate; a new model is taken or \
+                 requested at most this often",
+            ),
+        Rw::<N>::boolean("adapt_realtime", Shape::Scalar)
+            .parameter(Field::boolean(
+                |s, _| s.adapt_realtime,
+                |s, _, v| s.adapt_realtime = v,
+            ))
+            .describe(
+                "Adaptation for a real-time target: a solve never waits for the worker's new \
+                 model (taken at the first look after it is ready: the closed loop then depends \
+                 on the machine's speed). false: the next look waits for it, and every run \
+                 gives the same numbers",
+            ),
+        estimate(
+            a,
+            Shape::JointPairs,
+            "kg.m2",
+            "Link inertia amplitude A[j,l] (j <= l) of the kinetic energy 1/2 sum A[j,l] \
+             cos(phi_j - phi_l) w_j w_l, phi and w the absolute link angles and speeds",
+        ),
+        estimate(
+            g,
+            Shape::Joints,
+            "N.m",
+            "Gravity amplitude G[j] of the potential sum G[j] (1 - cos phi_j)",
+        ),
+        estimate(ir, Shape::Joints, "kg.m2", "Rotor inertia Ir[j]"),
+        estimate(b, Shape::Joints, "N.m.s/rad", "Viscous friction b[j]"),
+        estimate(cf, Shape::Joints, "N.m", "Coulomb friction cf[j]"),
+        Rw::<N>::integer("model_updates", Shape::Scalar)
+            .output()
+            .describe("Models taken from the identification so far (0 with adapt = false)"),
+    ]
 }
 
 /// The rows of the reference computed from the model (`chart_source`).

@@ -1,0 +1,99 @@
+//! The controller with its optional online adaptation ([`Settings::adapt`]):
+//! what the FMU and the plain C API run every sample, so that both adapt
+//! the same way.
+
+use super::settings::{ChainController, Settings};
+use eigenmpc::adapt::Adaptation;
+use eigenmpc::identify::BaseParameters;
+use eigenmpc::mechanics::Vector;
+use eigenmpc::mpc::ControlOutput;
+use nalgebra::SVector;
+
+/// An `N`-joint controller (`NX = 2 N`, `NP` =
+/// [`eigenmpc::identify::base_parameter_count`]`(N)`) and, with `adapt`,
+/// the identification its model follows.
+pub struct AdaptiveController<const N: usize, const NX: usize, const NP: usize> {
+    controller: ChainController<N, NX>,
+    adaptation: Option<Adaptation<N, NX, NP>>,
+    /// Base parameters of the model the controller was built with (None:
+    /// a model with joint springs has none).
+    prior: Option<BaseParameters<N, NP>>,
+    /// Torque of the previous sample (applied since then).
+    tau: Vector<N>,
+}
+
+impl<const N: usize, const NX: usize, const NP: usize> AdaptiveController<N, NX, NP> {
+    /// Builds the controller of `settings` and, with `adapt`, its
+    /// adaptation (refused for a model with joint springs: its energy is
+    /// not linear in the base parameters). Set-up: allocates, may take tens
+    /// of milliseconds (the mode family).
+    pub fn new(settings: &Settings<N>) -> Result<Self, String> {
+        let controller = settings.build::<NX>()?;
+        let params = *controller.system().params();
+        let prior = BaseParameters::<N, NP>::of(&params).ok();
+        let adaptation = if settings.adapt {
+            Some(
+                Adaptation::new(&params, settings.adapt_options())
+                    .map_err(|e| format!("adapt = true: {e}"))?,
+            )
+        } else {
+            None
+        };
+        Ok(Self {
+            controller,
+            adaptation,
+            prior,
+            tau: Vector::zeros(),
+        })
+    }
+
+    /// One sample at state `z`, `dt` seconds after the previous one: feeds
+    /// the identification with the measurement and the torque applied
+    /// since, takes a ready model, then solves. Allocation-free; waits for
+    /// the worker only without `adapt_realtime` (offline simulation).
+    pub fn step(&mut self, z: &SVector<f64, NX>, dt: f64) -> ControlOutput<N> {
+        if let Some(adaptation) = &mut self.adaptation {
+            let q = Vector::<N>::from_fn(|j, _| z[j]);
+            let qd = Vector::<N>::from_fn(|j, _| z[N + j]);
+            adaptation.sample(&mut self.controller, &q, &qd, &self.tau, dt);
+        }
+        let out = self.controller.step(z);
+        self.tau = out.tau;
+        out
+    }
+
+    /// Forgets the plan (as [`eigenmpc::mpc::Controller::reset`]) and the
+    /// open identification window: the next sample starts afresh. The
+    /// estimate and the adapted model are kept.
+    pub fn reset(&mut self) {
+        self.controller.reset();
+        if let Some(adaptation) = &mut self.adaptation {
+            adaptation.restart_window();
+        }
+        self.tau = Vector::zeros();
+    }
+
+    /// The controller.
+    pub fn controller(&self) -> &ChainController<N, NX> {
+        &self.controller
+    }
+
+    /// The controller, for tuning.
+    pub fn controller_mut(&mut self) -> &mut ChainController<N, NX> {
+        &mut self.controller
+    }
+
+    /// The base parameters: the identification's estimate with `adapt`,
+    /// else those of the model (None: a model with joint springs).
+    pub fn estimate(&self) -> Option<BaseParameters<N, NP>> {
+        match &self.adaptation {
+            Some(a) => Some(a.identification().estimate()),
+            None => self.prior,
+        }
+    }
+
+    /// Models taken from the identification so far (0 without `adapt`).
+    pub fn model_updates(&self) -> usize {
+        self.adaptation.as_ref().map_or(0, |a| a.model_updates())
+    }
+}

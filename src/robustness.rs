@@ -1,0 +1,252 @@
+//! Closed loops with the imperfections of a real set-up, as the published
+//! robustness benchmarks of double-pendulum controllers apply them: a plant
+//! that differs from the model (any [`PlanarChain`]), noisy and delayed
+//! measurements, a noisy and sluggish motor, and optionally the online
+//! adaptation ([`crate::adapt`]) that the controller runs against them.
+//!
+//! What the controller sees at sample `k` is the plant's state `delay`
+//! samples earlier plus Gaussian noise; what the plant gets over the sample
+//! is `u_k = a tau_k + (1 - a) u_(k-1)` (responsiveness `a`) plus Gaussian
+//! torque noise, held. The adaptation is fed the measurement and the
+//! commanded torque (what a controller knows).
+
+use crate::adapt::Adaptation;
+use crate::integrate::{Dopri5, IntegrationError, Tolerances};
+use crate::mechanics::{PlanarChain, Vector, state_derivative, state_energy};
+use crate::mpc::Controller;
+use crate::mpc::closed_loop::{GaussianNoise, Sample};
+use nalgebra::SVector;
+use std::collections::VecDeque;
+use std::time::Instant;
+
+/// The imperfections of one closed loop (the default: none).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Imperfections {
+    /// Standard deviation of the measured angles' (rad) and speeds'
+    /// (rad/s) noise.
+    pub measurement_noise: f64,
+    /// Standard deviation of the noise added to each joint's applied
+    /// torque, drawn once per sample (N m).
+    pub torque_noise: f64,
+    /// Motor responsiveness `a` in (0, 1]: the applied torque moves the
+    /// share `a` from the previous applied torque to the command per
+    /// sample (1: immediate).
+    pub responsiveness: f64,
+    /// Measurement delay in samples.
+    pub delay_samples: usize,
+    /// Seed of the noise (same seed, same run on every machine).
+    pub seed: u64,
+}
+
+impl Default for Imperfections {
+    fn default() -> Self {
+        Self {
+            measurement_noise: 0.0,
+            torque_noise: 0.0,
+            responsiveness: 1.0,
+            delay_samples: 0,
+            seed: 1,
+        }
+    }
+}
+
+impl Imperfections {
+    /// Checks the fields; the message names the offending one.
+    pub fn validate(&self) -> Result<(), String> {
+        for (name, v) in [
+            ("measurement_noise", self.measurement_noise),
+            ("torque_noise", self.torque_noise),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(format!("{name} = {v} must be finite and >= 0"));
+            }
+        }
+        if !(self.responsiveness > 0.0 && self.responsiveness <= 1.0) {
+            return Err(format!(
+                "responsiveness = {} must be in (0, 1]",
+                self.responsiveness
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// One imperfect closed loop: the samples (true state and energy, the
+/// torque the plant got), the compute time of the adaptation per sample
+/// (0 without) and the models it swapped in.
+#[derive(Clone, Debug)]
+pub struct ImperfectRun<const N: usize, const NX: usize> {
+    /// Per sample: the true state, the applied torque, the plant's energy.
+    pub samples: Vec<Sample<N, NX>>,
+    /// Wall time of `Adaptation::sample` per sample (s).
+    pub adaptation_time: Vec<f64>,
+    /// Models the adaptation swapped in.
+    pub model_updates: usize,
+}
+
+/// Runs `duration` seconds of `controller` (and `adaptation`, if given) on
+/// `plant` from `z0` with `imperfections`; the plant is integrated by
+/// adaptive Dormand-Prince (rtol = atol = 1e-10), the applied torque held
+/// over each sample.
+pub fn run_imperfect<const N: usize, const NX: usize, const NP: usize>(
+    controller: &mut Controller<PlanarChain<N>, N, NX>,
+    mut adaptation: Option<&mut Adaptation<N, NX, NP>>,
+    plant: &PlanarChain<N>,
+    z0: &SVector<f64, NX>,
+    duration: f64,
+    imperfections: &Imperfections,
+) -> Result<ImperfectRun<N, NX>, IntegrationError> {
+    let dt = controller.config().dt;
+    let steps = (duration / dt).round() as usize;
+    let mut samples = Vec::with_capacity(steps + 1);
+    let mut adaptation_time = Vec::with_capacity(steps + 1);
+    let tol = Tolerances {
+        rtol: 1e-10,
+        atol: 1e-10,
+    };
+    let mut ode = Dopri5::new(0.0, *z0, tol);
+    let mut noise = GaussianNoise::new(imperfections.seed);
+    // Before the first sample the plant rested at z0.
+    let mut history: VecDeque<SVector<f64, NX>> =
+        std::iter::repeat_n(*z0, imperfections.delay_samples).collect();
+    let a = imperfections.responsiveness;
+    let mut applied = Vector::<N>::zeros();
+    let mut commanded = Vector::<N>::zeros();
+    for i in 0..=steps {
+        let t = i as f64 * dt;
+        let z = *ode.state();
+        history.push_back(z);
+        let seen = history.pop_front().unwrap_or(z);
+        let measured = if imperfections.measurement_noise > 0.0 {
+            let s = imperfections.measurement_noise;
+            noise.measure(&seen, s, s)
+        } else {
+            seen
+        };
+        let started = Instant::now();
+        if let Some(adaptation) = adaptation.as_deref_mut() {
+            let q = Vector::<N>::from_fn(|j, _| measured[j]);
+            let qd = Vector::<N>::from_fn(|j, _| measured[N + j]);
+            adaptation.sample(controller, &q, &qd, &commanded, dt);
+        }
+        adaptation_time.push(started.elapsed().as_secs_f64());
+        let out = controller.step(&measured);
+        commanded = out.tau;
+        applied = commanded * a + applied * (1.0 - a);
+        let mut torque = applied;
+        if imperfections.torque_noise > 0.0 {
+            for j in 0..N {
+                torque[j] += imperfections.torque_noise * noise.sample();
+            }
+        }
+        samples.push(Sample {
+            time: t,
+            state: z,
+            tau: torque,
+            energy: state_energy::<PlanarChain<N>, N, NX>(plant, &z),
+            solve_time: out.preparation_time + out.feedback_time,
+            preparation_time: out.preparation_time,
+            status: out.status,
+            qp_iterations: out.qp_iterations,
+        });
+        if i == steps {
+            break;
+        }
+        ode.advance_to(
+            |_, z| state_derivative::<PlanarChain<N>, N, NX>(plant, z, &torque),
+            (i + 1) as f64 * dt,
+        )?;
+    }
+    Ok(ImperfectRun {
+        samples,
+        adaptation_time,
+        model_updates: adaptation.map_or(0, |a| a.model_updates()),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mechanics::PlanarChainParams;
+    use crate::mpc::closed_loop::{reference_for, run};
+    use crate::mpc::{MpcConfig, Variant};
+
+    fn controller() -> Controller<PlanarChain<2>, 2, 4> {
+        let model = PlanarChain::new(PlanarChainParams::default()).unwrap();
+        let reference = reference_for::<_, 2, 4>(&model, Variant::Curved, 0, 14.0).unwrap();
+        let mut config = MpcConfig::paper(Variant::Curved);
+        config.horizon = 20;
+        Controller::new(model, config, reference).unwrap()
+    }
+
+    /// Without imperfections the loop is the plain closed loop, sample for
+    /// sample.
+    #[test]
+    fn no_imperfections_is_the_plain_closed_loop() {
+        let plant = PlanarChain::new(PlanarChainParams::default()).unwrap();
+        let z0 = SVector::<f64, 4>::new(0.05, 0.05, 0.0, 0.0);
+        let plain = run(&mut controller(), &plant, &z0, 2.0).unwrap();
+        let imperfect = run_imperfect::<2, 4, 11>(
+            &mut controller(),
+            None,
+            &plant,
+            &z0,
+            2.0,
+            &Imperfections::default(),
+        )
+        .unwrap();
+        assert_eq!(plain.len(), imperfect.samples.len());
+        for (a, b) in plain.iter().zip(&imperfect.samples) {
+            assert_eq!((a.state, a.tau, a.energy), (b.state, b.tau, b.energy));
+        }
+    }
+
+    /// The delay shows the controller the state of `delay` samples ago; a
+    /// sluggish motor moves the share `a` towards the command per sample.
+    #[test]
+    fn delay_and_responsiveness_act_as_defined() {
+        let plant = PlanarChain::new(PlanarChainParams::default()).unwrap();
+        let z0 = SVector::<f64, 4>::new(0.05, 0.05, 0.0, 0.0);
+        let plain = run_imperfect::<2, 4, 11>(
+            &mut controller(),
+            None,
+            &plant,
+            &z0,
+            1.0,
+            &Imperfections::default(),
+        )
+        .unwrap();
+        let lag = Imperfections {
+            responsiveness: 0.5,
+            ..Imperfections::default()
+        };
+        let lagged =
+            run_imperfect::<2, 4, 11>(&mut controller(), None, &plant, &z0, 1.0, &lag).unwrap();
+        // same first command (same state), half of it applied
+        assert_eq!(lagged.samples[0].tau, plain.samples[0].tau * 0.5);
+        // a delayed controller's first samples see z0: the same command as
+        // the undelayed one at t = 0, while the plant has moved
+        let delayed = Imperfections {
+            delay_samples: 2,
+            ..Imperfections::default()
+        };
+        let mut c = controller();
+        let run = run_imperfect::<2, 4, 11>(&mut c, None, &plant, &z0, 1.0, &delayed).unwrap();
+        let mut reference = controller();
+        let first = reference.step(&z0).tau;
+        assert_eq!(run.samples[0].tau, first);
+        assert_eq!(run.samples[1].tau, reference.step(&z0).tau);
+        assert_eq!(
+            run.samples[2].tau,
+            reference.step(&run.samples[0].state).tau
+        );
+        assert!(
+            Imperfections {
+                responsiveness: 0.0,
+                ..Imperfections::default()
+            }
+            .validate()
+            .is_err()
+        );
+    }
+}
