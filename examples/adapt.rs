@@ -7,17 +7,12 @@
 //! s). Run with `cargo run --release --example adapt -- [duration] [period]`.
 
 use eigenmpc::adapt::{AdaptOptions, Adaptation};
-use eigenmpc::integrate::{Dopri5, Tolerances};
-use eigenmpc::mechanics::{
-    MechanicalSystem, PlanarChain, PlanarChainParams, Vector, state_derivative,
-};
+use eigenmpc::mechanics::{PlanarChain, PlanarChainParams, Vector};
 use eigenmpc::modes::{ChartFamily, FamilyOptions};
-use eigenmpc::mpc::closed_loop::{distance_to_path, mode_and_chart};
+use eigenmpc::mpc::closed_loop::{Sample, distance_to_path, mode_and_chart};
 use eigenmpc::mpc::{Controller, MpcConfig, Variant};
+use eigenmpc::robustness::{Imperfections, run_imperfect};
 use nalgebra::SVector;
-
-/// State and torque of one sample of the last 5 s.
-type TailSample = (SVector<f64, 4>, Vector<2>);
 
 fn main() {
     let args: Vec<f64> = std::env::args()
@@ -46,62 +41,48 @@ fn main() {
                 .unwrap();
         let config = MpcConfig::paper(Variant::Curved);
         let mut ctrl = Controller::<_, 2, 4>::with_family(model, config, family).unwrap();
-        let dt = config.dt;
         let mut adaptation = Adaptation::<2, 4, 11>::new(
             &prior,
             AdaptOptions {
-                period: (period / dt).round() as usize,
+                period: (period / config.dt).round() as usize,
                 // reproducible figures: wait for each model (offline only)
                 synchronous: true,
                 ..AdaptOptions::default()
             },
         )
         .unwrap();
-        let tol = Tolerances {
-            rtol: 1e-10,
-            atol: 1e-10,
-        };
-        let mut ode = Dopri5::new(0.0, SVector::<f64, 4>::new(0.05, 0.05, 0.0, 0.0), tol);
-        let mut tau = Vector::<2>::zeros();
-        let steps = (duration / dt).round() as usize;
-        let mut tail = vec![];
-        for k in 0..steps {
-            let z = *ode.state();
-            let (q, qd) = (Vector::<2>::new(z[0], z[1]), Vector::<2>::new(z[2], z[3]));
-            if adapt {
-                adaptation.sample(&mut ctrl, &q, &qd, &tau, dt);
-            }
-            tau = ctrl.step(&z).tau;
-            if k as f64 * dt >= duration - 5.0 {
-                tail.push((z, tau));
-            }
-            ode.advance_to(
-                |_, z| state_derivative::<_, 2, 4>(&plant, z, &tau),
-                (k + 1) as f64 * dt,
-            )
-            .unwrap();
-        }
-        let z = *ode.state();
-        let energy = |z: &SVector<f64, 4>| {
-            plant.energy(&Vector::<2>::new(z[0], z[1]), &Vector::<2>::new(z[2], z[3]))
-        };
+        let run = run_imperfect(
+            &mut ctrl,
+            adapt.then_some(&mut adaptation),
+            &plant,
+            &SVector::<f64, 4>::new(0.05, 0.05, 0.0, 0.0),
+            duration,
+            &Imperfections::default(),
+        )
+        .unwrap();
+        let tail: Vec<_> = run
+            .samples
+            .iter()
+            .filter(|s| s.time > duration - 5.0 + 1e-9)
+            .collect();
         let n = tail.len() as f64;
-        let mean_e = tail.iter().map(|(z, _)| energy(z)).sum::<f64>() / n;
-        let rms = |f: &dyn Fn(&TailSample) -> f64| {
+        let mean_e = tail.iter().map(|s| s.energy).sum::<f64>() / n;
+        let rms = |f: &dyn Fn(&Sample<2, 4>) -> f64| {
             (tail.iter().map(|s| f(s).powi(2)).sum::<f64>() / n).sqrt()
         };
-        let tau_rms = [rms(&|s| s.1[0]), rms(&|s| s.1[1])];
-        let damping = [rms(&|s| 0.05 * s.0[2]), rms(&|s| 0.05 * s.0[3])];
-        let dist = rms(&|s| distance_to_path(&Vector::<2>::new(s.0[0], s.0[1]), &true_mode.path));
+        let tau_rms = [rms(&|s| s.tau[0]), rms(&|s| s.tau[1])];
+        let damping = [rms(&|s| 0.05 * s.state[2]), rms(&|s| 0.05 * s.state[3])];
+        let dist =
+            rms(&|s| distance_to_path(&Vector::<2>::new(s.state[0], s.state[1]), &true_mode.path));
         println!(
             "| {} | {:.4} | {mean_e:.4} | {:.4} / {:.4} | {:.4} / {:.4} | {dist:.4} | {} |",
             if adapt { "on" } else { "off" },
-            energy(&z),
+            run.samples.last().unwrap().energy,
             tau_rms[0],
             tau_rms[1],
             damping[0],
             damping[1],
-            adaptation.model_updates()
+            run.model_updates
         );
     }
 }

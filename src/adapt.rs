@@ -151,10 +151,12 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
         self.failures
     }
 
-    /// One sample, before the controller's step: `(q, qd)` measured now,
-    /// `tau` the torque applied since the previous sample, `dt` ago. Feeds
-    /// the identification; swaps a ready model and family into
-    /// `controller`; posts a new one when the estimate has moved.
+    /// One sample, before or after the controller's step (the
+    /// `AdaptiveController` of the FMU calls it after, with the state the
+    /// step used): `(q, qd)` measured now, `tau` the torque applied since
+    /// the previous sample, `dt` ago. Feeds the identification; swaps a
+    /// ready model and family into `controller`; posts a new one when the
+    /// estimate has moved.
     pub fn sample(
         &mut self,
         controller: &mut Controller<PlanarChain<N>, N, NX>,

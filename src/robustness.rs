@@ -123,14 +123,18 @@ pub fn run_imperfect<const N: usize, const NX: usize, const NP: usize>(
         } else {
             seen
         };
+        let out = controller.step(&measured);
+        // The identification takes the state the controller used (its
+        // estimate, with a state estimator) and the torque it commanded
+        // over the sample before; a new model serves from the next sample.
         let started = Instant::now();
         if let Some(adaptation) = adaptation.as_deref_mut() {
-            let q = Vector::<N>::from_fn(|j, _| measured[j]);
-            let qd = Vector::<N>::from_fn(|j, _| measured[N + j]);
+            let used = controller.state_estimate().copied().unwrap_or(measured);
+            let q = Vector::<N>::from_fn(|j, _| used[j]);
+            let qd = Vector::<N>::from_fn(|j, _| used[N + j]);
             adaptation.sample(controller, &q, &qd, &commanded, dt);
         }
         adaptation_time.push(started.elapsed().as_secs_f64());
-        let out = controller.step(&measured);
         commanded = out.tau;
         applied = commanded * a + applied * (1.0 - a);
         let mut torque = applied;

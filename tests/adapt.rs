@@ -5,13 +5,11 @@
 //! without it the energy ends far off. The sample path allocates nothing.
 
 use eigenmpc::adapt::{AdaptOptions, Adaptation};
-use eigenmpc::integrate::{Dopri5, Tolerances};
-use eigenmpc::mechanics::{
-    MechanicalSystem, PlanarChain, PlanarChainParams, Vector, state_derivative,
-};
+use eigenmpc::mechanics::{PlanarChain, PlanarChainParams, Vector};
 use eigenmpc::modes::{ChartFamily, FamilyOptions};
-use eigenmpc::mpc::closed_loop::{distance_to_path, mode_and_chart};
+use eigenmpc::mpc::closed_loop::{Sample, distance_to_path, mode_and_chart};
 use eigenmpc::mpc::{Controller, MpcConfig, Variant};
+use eigenmpc::robustness::{Imperfections, run_imperfect};
 use nalgebra::SVector;
 
 struct Outcome {
@@ -55,46 +53,28 @@ fn closed_loop(adapt: bool, seconds: f64) -> Outcome {
             ..AdaptOptions::default()
         },
     );
-    let dt = ctrl.config().dt;
-    let tol = Tolerances {
-        rtol: 1e-10,
-        atol: 1e-10,
-    };
-    let mut ode = Dopri5::new(0.0, SVector::<f64, 4>::new(0.05, 0.05, 0.0, 0.0), tol);
-    let mut tau = Vector::<2>::zeros();
-    let mut tail = vec![];
-    let steps = (seconds / dt).round() as usize;
-    for k in 0..steps {
-        let z = *ode.state();
-        let (q, qd) = (Vector::<2>::new(z[0], z[1]), Vector::<2>::new(z[2], z[3]));
-        if adapt {
-            adaptation.sample(&mut ctrl, &q, &qd, &tau, dt);
-        }
-        tau = ctrl.step(&z).tau;
-        if k + 200 >= steps {
-            tail.push((q, qd, tau));
-        }
-        ode.advance_to(
-            |_, z| state_derivative::<_, 2, 4>(&plant, z, &tau),
-            (k + 1) as f64 * dt,
-        )
-        .unwrap();
-    }
+    let run = run_imperfect(
+        &mut ctrl,
+        adapt.then_some(&mut adaptation),
+        &plant,
+        &SVector::<f64, 4>::new(0.05, 0.05, 0.0, 0.0),
+        seconds,
+        &Imperfections::default(),
+    )
+    .unwrap();
+    let tail = &run.samples[run.samples.len() - 200..];
     let (mode, _) = mode_and_chart::<_, 2, 4>(&plant, 0, 14.0, 9).unwrap();
     let n = tail.len() as f64;
-    let rms = |f: &dyn Fn(&(Vector<2>, Vector<2>, Vector<2>)) -> f64| {
+    let rms = |f: &dyn Fn(&Sample<2, 4>) -> f64| {
         (tail.iter().map(|s| f(s).powi(2)).sum::<f64>() / n).sqrt()
     };
+    let q = |s: &Sample<2, 4>| Vector::<2>::new(s.state[0], s.state[1]);
     Outcome {
-        mean_energy: tail
-            .iter()
-            .map(|(q, qd, _)| plant.energy(q, qd))
-            .sum::<f64>()
-            / n,
-        rms_torque: [rms(&|s| s.2[0]), rms(&|s| s.2[1])],
-        rms_damping: [rms(&|s| 0.05 * s.1[0]), rms(&|s| 0.05 * s.1[1])],
-        rms_distance: rms(&|s| distance_to_path(&s.0, &mode.path)),
-        model_updates: adaptation.model_updates(),
+        mean_energy: tail.iter().map(|s| s.energy).sum::<f64>() / n,
+        rms_torque: [rms(&|s| s.tau[0]), rms(&|s| s.tau[1])],
+        rms_damping: [rms(&|s| 0.05 * s.state[2]), rms(&|s| 0.05 * s.state[3])],
+        rms_distance: rms(&|s| distance_to_path(&q(s), &mode.path)),
+        model_updates: run.model_updates,
     }
 }
 

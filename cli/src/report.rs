@@ -13,6 +13,32 @@ use std::path::Path;
 #[error("plot failed: {0}")]
 pub struct PlotError(String);
 
+impl PlotError {
+    /// A plot error with this message.
+    pub fn new(message: impl Into<String>) -> Self {
+        Self(message.into())
+    }
+}
+
+/// Registers the embedded font as `sans-serif` (the plots need no system
+/// fontconfig).
+pub fn register_font() -> Result<(), PlotError> {
+    plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
+        .map_err(|_| PlotError("embedded font is invalid".into()))
+}
+
+/// A number for a tick label or table cell: at most 4 decimals, trailing
+/// zeros dropped, never `-0`.
+pub fn number(x: f64) -> String {
+    let text = format!("{:.4}", x);
+    let text = if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        text
+    };
+    if text == "-0" { "0".into() } else { text }
+}
+
 /// The summary figures as aligned text lines (time to 5 %, final energy
 /// error, RMS torque and distance over the last 5 s, solve times).
 pub fn summary_text<const N: usize>(s: &Summary<N>) -> String {
@@ -114,8 +140,7 @@ pub fn plot_run<const N: usize, const NX: usize>(
 ) -> Result<(), PlotError> {
     const { assert!(N >= 2, "the joint-space panel needs two joints") };
     // The font ships with the binary: no system fontconfig needed.
-    plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
-        .map_err(|_| PlotError("embedded font is invalid".into()))?;
+    register_font()?;
     let size = (500 * (N as u32 + 1), 900);
     let svg = path
         .extension()

@@ -1,13 +1,7 @@
 //! `eigenmpc simulate`: summary, CSV columns, plots, clear errors.
 
-use std::process::Command;
-
-fn eigenmpc(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_eigenmpc"))
-        .args(args)
-        .output()
-        .expect("run eigenmpc")
-}
+mod common;
+use common::eigenmpc;
 
 #[test]
 fn simulate_writes_csv_and_plots() {

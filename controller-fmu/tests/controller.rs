@@ -869,8 +869,9 @@ fn adapt_follows_the_identified_plant_like_the_library() {
     for k in 0..(12.0 / DT) as usize {
         let z = *ode.state();
         let (q, qd) = (Vector::<2>::new(z[0], z[1]), Vector::<2>::new(z[2], z[3]));
+        let out = native.step(&z).tau;
         adaptation.sample(&mut native, &q, &qd, &tau, DT);
-        tau = native.step(&z).tau;
+        tau = out;
         // a solve at t_k takes the inputs set before fmi2DoStep(t_k, h)
         // (t_0: at initialization)
         if k > 0 {

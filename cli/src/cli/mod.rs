@@ -2,6 +2,7 @@
 //! non-zero exit code, never as a panic trace.
 
 mod modes;
+mod robustness;
 mod simulate;
 
 use clap::{Args, Parser, Subcommand};
@@ -24,6 +25,9 @@ enum Command {
     Modes(modes::ModesArgs),
     /// Closed loop of the EigenMPC controller against the accurate plant; prints a summary.
     Simulate(Box<simulate::SimulateArgs>),
+    /// Robustness report: the controller against plants and set-ups that differ from its model
+    /// (each parameter, noise, motor lag, delay), without and with online adaptation.
+    Robustness(Box<robustness::RobustnessArgs>),
 }
 
 /// The robot: a parameter file, or the paper's point-mass double pendulum
@@ -154,6 +158,7 @@ pub fn main() -> ExitCode {
     let result = match cli.command {
         Command::Modes(args) => modes::run(&args),
         Command::Simulate(args) => simulate::run_simulate(&args),
+        Command::Robustness(args) => robustness::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -47,17 +47,20 @@ impl<const N: usize, const NX: usize, const NP: usize> AdaptiveController<N, NX,
         })
     }
 
-    /// One sample at state `z`, `dt` seconds after the previous one: feeds
-    /// the identification with the measurement and the torque applied
-    /// since, takes a ready model, then solves. Allocation-free; waits for
-    /// the worker only without `adapt_realtime` (offline simulation).
+    /// One sample at state `z`, `dt` seconds after the previous one:
+    /// solves, then feeds the identification with the state the solve used
+    /// (the state estimate with `state_estimator = ekf`, else `z`) and the
+    /// torque applied since the previous sample, and takes a ready model
+    /// for the next sample. Allocation-free; waits for the worker only
+    /// without `adapt_realtime` (offline simulation).
     pub fn step(&mut self, z: &SVector<f64, NX>, dt: f64) -> ControlOutput<N> {
+        let out = self.controller.step(z);
         if let Some(adaptation) = &mut self.adaptation {
-            let q = Vector::<N>::from_fn(|j, _| z[j]);
-            let qd = Vector::<N>::from_fn(|j, _| z[N + j]);
+            let used = self.controller.state_estimate().copied().unwrap_or(*z);
+            let q = Vector::<N>::from_fn(|j, _| used[j]);
+            let qd = Vector::<N>::from_fn(|j, _| used[N + j]);
             adaptation.sample(&mut self.controller, &q, &qd, &self.tau, dt);
         }
-        let out = self.controller.step(z);
         self.tau = out.tau;
         out
     }

@@ -1,0 +1,315 @@
+//! The robustness report's outputs: scores and per-run tables (Markdown),
+//! one CSV row per run, and one plot panel per category (energy error
+//! against the varied quantity, success marked).
+
+use super::{CATEGORIES, Case, Outcome};
+use crate::report::{PlotError, register_font};
+use plotters::prelude::*;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// One case with its outcome without and with adaptation.
+#[derive(Clone, Debug)]
+pub struct RunPair {
+    /// The case.
+    pub case: Case,
+    /// Without adaptation.
+    pub off: Outcome,
+    /// With adaptation.
+    pub on: Outcome,
+}
+
+/// Share of successful runs of `category` (off, on) and the number of runs.
+pub fn score(rows: &[RunPair], category: &str) -> (f64, f64, usize) {
+    let runs: Vec<&RunPair> = rows
+        .iter()
+        .filter(|r| r.case.category == category)
+        .collect();
+    let n = runs.len();
+    let share = |f: fn(&RunPair) -> bool| {
+        if n == 0 {
+            f64::NAN
+        } else {
+            runs.iter().filter(|r| f(r)).count() as f64 / n as f64
+        }
+    };
+    (share(|r| r.off.success), share(|r| r.on.success), n)
+}
+
+fn outcome_cells(o: &Outcome) -> String {
+    format!(
+        "{} | {} | {:+.2} | {:.3} / {:.3} |",
+        if o.success { "yes" } else { "**no**" },
+        o.time_to_band.map_or("-".into(), |t| format!("{t:.1}")),
+        100.0 * o.energy_error,
+        o.rms_torque[0],
+        o.rms_torque[1]
+    )
+}
+
+/// The Markdown report: `title` (the configuration), the score table, and
+/// one table per category.
+pub fn markdown(title: &str, rows: &[RunPair]) -> String {
+    let mut s =
+        format!("{title}\n\n## Scores (share of runs that reach the 5 % band and stay)\n\n");
+    s.push_str("| category | runs | without adaptation | with adaptation |\n|---|---|---|---|\n");
+    let (mut all_off, mut all_on, mut all_n) = (0.0, 0.0, 0usize);
+    for category in CATEGORIES {
+        let (off, on, n) = score(rows, category);
+        if n == 0 {
+            continue;
+        }
+        writeln!(s, "| {category} | {n} | {:.2} | {:.2} |", off, on).unwrap();
+        all_off += off * n as f64;
+        all_on += on * n as f64;
+        all_n += n;
+    }
+    if all_n > 0 {
+        writeln!(
+            s,
+            "| **all** | {all_n} | {:.2} | {:.2} |",
+            all_off / all_n as f64,
+            all_on / all_n as f64
+        )
+        .unwrap();
+    }
+    s.push_str(
+        "\nPer run: success, time the band was entered for good (s), energy error of the mean \
+         over the last 5 s (%), RMS applied torque over the last 5 s (N m), without | with \
+         adaptation.\n",
+    );
+    for category in CATEGORIES {
+        let runs: Vec<&RunPair> = rows
+            .iter()
+            .filter(|r| r.case.category == category)
+            .collect();
+        let Some(first) = runs.first() else { continue };
+        writeln!(s, "\n### {category}\n").unwrap();
+        let unit = if first.case.unit.is_empty() {
+            String::new()
+        } else {
+            format!(" ({})", first.case.unit)
+        };
+        writeln!(
+            s,
+            "| parameter | value{unit} | ok | band (s) | E error (%) | tau RMS (N m) | ok (adapt) | band (s) | E error (%) | tau RMS (N m) | models |"
+        )
+        .unwrap();
+        s.push_str("|---|---|---|---|---|---|---|---|---|---|---|\n");
+        for r in runs {
+            writeln!(
+                s,
+                "| {} | {} | {} {} {} |",
+                r.case.parameter,
+                crate::report::number(r.case.value),
+                outcome_cells(&r.off),
+                outcome_cells(&r.on),
+                r.on.model_updates
+            )
+            .unwrap();
+        }
+    }
+    s
+}
+
+/// One CSV row per run and adaptation setting.
+pub fn csv(rows: &[RunPair]) -> String {
+    let mut s = String::from(
+        "category,parameter,value,unit,adapt,success,time_to_band_s,energy_error,rms_tau1_Nm,rms_tau2_Nm,failed_solves,model_updates\n",
+    );
+    for r in rows {
+        for (adapt, o) in [(false, &r.off), (true, &r.on)] {
+            writeln!(
+                s,
+                "{},{},{},{},{},{},{},{},{},{},{},{}",
+                r.case.category,
+                r.case.parameter,
+                r.case.value,
+                r.case.unit,
+                adapt,
+                o.success,
+                o.time_to_band.map_or(String::new(), |t| t.to_string()),
+                o.energy_error,
+                o.rms_torque[0],
+                o.rms_torque[1],
+                o.failed_solves,
+                o.model_updates
+            )
+            .unwrap();
+        }
+    }
+    s
+}
+
+/// Plots one panel per category: the energy error (%) of the mean over
+/// the last 5 s against the varied quantity, without (blue) and with
+/// (orange) adaptation, one line per parameter; a filled circle is a
+/// success, a cross a failure; the 5 % band is shaded. PNG, or SVG when
+/// the name ends in `.svg`.
+pub fn plot(path: &Path, title: &str, rows: &[RunPair]) -> Result<(), PlotError> {
+    register_font()?;
+    let categories: Vec<&str> = CATEGORIES
+        .into_iter()
+        .filter(|c| rows.iter().any(|r| r.case.category == *c))
+        .collect();
+    let columns = categories.len().clamp(1, 5);
+    let lines = categories.len().div_ceil(columns).max(1);
+    let size = (380 * columns as u32, 340 * lines as u32 + 60);
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("svg"))
+    {
+        draw(
+            SVGBackend::new(path, size).into_drawing_area(),
+            title,
+            rows,
+            &categories,
+            (lines, columns),
+        )
+    } else {
+        draw(
+            BitMapBackend::new(path, size).into_drawing_area(),
+            title,
+            rows,
+            &categories,
+            (lines, columns),
+        )
+    }
+}
+
+fn draw<DB: DrawingBackend>(
+    root: DrawingArea<DB, plotters::coord::Shift>,
+    title: &str,
+    rows: &[RunPair],
+    categories: &[&str],
+    grid: (usize, usize),
+) -> Result<(), PlotError>
+where
+    DB::ErrorType: 'static,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| PlotError::new(format!("{e}"));
+    root.fill(&WHITE).map_err(err)?;
+    let root = root.titled(title, ("sans-serif", 22)).map_err(err)?;
+    let panels = root.split_evenly(grid);
+    let off_colour = RGBColor(31, 119, 180);
+    let on_colour = RGBColor(255, 127, 14);
+    for (panel, category) in panels.iter().zip(categories) {
+        let runs: Vec<&RunPair> = rows
+            .iter()
+            .filter(|r| r.case.category == *category)
+            .collect();
+        let (off, on, n) = score(rows, category);
+        let values = runs.iter().map(|r| r.case.value);
+        let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+        let pad = ((hi - lo) * 0.08).max(1e-3 * hi.abs().max(1e-3));
+        // Errors beyond +-60 % are drawn at the edge (the table has them).
+        let clip = |e: f64| (100.0 * e).clamp(-60.0, 60.0);
+        let errors = runs
+            .iter()
+            .flat_map(|r| [clip(r.off.energy_error), clip(r.on.energy_error)]);
+        let (elo, ehi) = errors.fold((-6.0f64, 6.0f64), |(a, b), v| (a.min(v), b.max(v)));
+        let unit = runs.first().map_or("", |r| r.case.unit);
+        let parameter = runs.first().map_or("", |r| r.case.parameter.as_str());
+        let x_desc = match unit {
+            "x nominal" => "factor of the nominal value".to_string(),
+            "" => parameter.to_string(),
+            unit => format!("{parameter} ({unit})"),
+        };
+        let mut chart = ChartBuilder::on(panel)
+            .caption(
+                format!(
+                    "{category}: {:.0} % / {:.0} % of {n}",
+                    100.0 * off,
+                    100.0 * on
+                ),
+                ("sans-serif", 17),
+            )
+            .margin(12)
+            .x_label_area_size(42)
+            .y_label_area_size(52)
+            .build_cartesian_2d((lo - pad)..(hi + pad), (elo * 1.1)..(ehi * 1.1))
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc(x_desc)
+            .y_desc("energy error (%)")
+            .x_labels(6)
+            .x_label_formatter(&|v| crate::report::number(*v))
+            .y_label_formatter(&|v| crate::report::number(*v))
+            .label_style(("sans-serif", 14))
+            .draw()
+            .map_err(err)?;
+        chart
+            .draw_series(std::iter::once(Rectangle::new(
+                [(lo - pad, -5.0), (hi + pad, 5.0)],
+                RGBColor(0, 160, 0).mix(0.12).filled(),
+            )))
+            .map_err(err)?
+            .label("5 % band")
+            .legend(|(x, y)| {
+                Rectangle::new(
+                    [(x, y - 5), (x + 14, y + 5)],
+                    RGBColor(0, 160, 0).mix(0.3).filled(),
+                )
+            });
+        let mut parameters: Vec<&str> = runs.iter().map(|r| r.case.parameter.as_str()).collect();
+        parameters.dedup();
+        for (k, parameter) in parameters.iter().enumerate() {
+            let of: Vec<&&RunPair> = runs
+                .iter()
+                .filter(|r| r.case.parameter == *parameter)
+                .collect();
+            for (adapt, colour) in [(false, off_colour), (true, on_colour)] {
+                let pick = |r: &RunPair| if adapt { r.on.clone() } else { r.off.clone() };
+                let style = if k == 0 {
+                    colour.stroke_width(2)
+                } else {
+                    colour.mix(0.55).stroke_width(2)
+                };
+                let points: Vec<(f64, f64, bool)> = of
+                    .iter()
+                    .map(|r| {
+                        let o = pick(r);
+                        (r.case.value, clip(o.energy_error), o.success)
+                    })
+                    .collect();
+                let label = format!(
+                    "{}{}",
+                    if parameters.len() > 1 {
+                        format!("{parameter} ")
+                    } else {
+                        String::new()
+                    },
+                    if adapt { "adapt" } else { "no adapt" }
+                );
+                chart
+                    .draw_series(LineSeries::new(points.iter().map(|p| (p.0, p.1)), style))
+                    .map_err(err)?
+                    .label(label)
+                    .legend(move |(x, y)| PathElement::new([(x, y), (x + 14, y)], style));
+                chart
+                    .draw_series(points.iter().map(|&(x, y, ok)| {
+                        let marker: DynElement<DB, (f64, f64)> = if ok {
+                            Circle::new((x, y), 4, colour.filled()).into_dyn()
+                        } else {
+                            Cross::new((x, y), 5, colour.stroke_width(2)).into_dyn()
+                        };
+                        marker
+                    }))
+                    .map_err(err)?;
+            }
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK.mix(0.3))
+            .label_font(("sans-serif", 12))
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(err)?;
+    }
+    root.present().map_err(err)?;
+    Ok(())
+}
