@@ -22,12 +22,11 @@
 
 use crate::STATUS_BAD_ARGUMENT;
 use eigenmpc::mpc::{ControlStatus, CostParams, Variant};
-use eigenmpc_fmu_models::chain::ChainParameters;
 use eigenmpc_fmu_models::controller::ControllerProduct;
 use eigenmpc_fmu_models::controller::adaptive::AdaptiveController;
-use eigenmpc_fmu_models::controller::named::settings_from_named;
+use eigenmpc_fmu_models::controller::named::{check_named, settings_from_named};
 use eigenmpc_fmu_models::controller::settings::{ChartSource, Settings, Tuning};
-use eigenmpc_fmu_models::enums::{CHART_SOURCE, QP_SOLVER, VARIANT};
+use eigenmpc_fmu_models::enums::{CHART_SOURCE, QP_SOLVER};
 use eigenmpc_fmu_models::products::{EigenMpc2, EigenMpc3};
 use nalgebra::SVector;
 use std::ffi::{CStr, CString, c_char};
@@ -194,37 +193,75 @@ impl EigenMpc {
     }
 }
 
-fn settings_from(config: &EigenMpcConfig) -> Result<Settings<2>, String> {
-    let variant = VARIANT.value(config.variant)?;
-    Ok(Settings {
-        variant,
-        qp: QP_SOLVER.value(config.qp_solver)?,
-        tuning: tuning_from(config),
-        tau_max: config.tau_max,
-        horizon: config.horizon as usize,
-        sample_period: config.sample_period,
-        model: ChainParameters::point_masses(config.masses, config.lengths, config.gravity),
-        eigenvector: config.eigenvector,
-        chart_source: CHART_SOURCE.value(config.chart_source)?,
-        mode: match config.mode {
-            1 | 2 => config.mode as usize - 1,
-            m => return Err(format!("mode = {m} must be 1 (in-phase) or 2 (anti-phase)")),
-        },
-        family_energy_max: config.family_energy_max,
-        adapt: c_bool("adapt", config.adapt)?,
-        adapt_period: config.adapt_period,
-        adapt_realtime: c_bool("adapt_realtime", config.adapt_realtime)?,
-        // what the config does not hold: the FMU's defaults (the 14 J chart, ...)
-        ..EigenMpc2::settings(variant)
-    })
+/// The config's fields as the controller FMU's parameters: `(C field,
+/// FMU name, value)`. The FMU's variable table checks them, so the C API
+/// and the FMU accept the same ranges.
+fn named_fields(config: &EigenMpcConfig) -> [(&'static str, &'static str, f64); 25] {
+    [
+        ("variant", "variant", f64::from(config.variant)),
+        ("e_ref", "E_ref", config.e_ref),
+        ("alpha", "alpha", config.alpha),
+        ("beta", "beta", config.beta),
+        ("w_e", "w_E", config.w_e),
+        ("w_x", "w_x", config.w_x),
+        ("w_xd", "w_xd", config.w_xd),
+        ("w_f", "w_F", config.w_f),
+        ("tau_max", "tau_max", config.tau_max),
+        ("horizon", "horizon", f64::from(config.horizon)),
+        ("sample_period", "sample_period", config.sample_period),
+        ("masses[0]", "m[1]", config.masses[0]),
+        ("masses[1]", "m[2]", config.masses[1]),
+        ("lengths[0]", "l[1]", config.lengths[0]),
+        ("lengths[1]", "l[2]", config.lengths[1]),
+        ("gravity", "g", config.gravity),
+        ("eigenvector[0]", "c[1]", config.eigenvector[0]),
+        ("eigenvector[1]", "c[2]", config.eigenvector[1]),
+        ("qp_solver", "qp_solver", f64::from(config.qp_solver)),
+        (
+            "chart_source",
+            "chart_source",
+            f64::from(config.chart_source),
+        ),
+        ("mode", "mode", f64::from(config.mode)),
+        (
+            "family_energy_max",
+            "family_energy_max",
+            config.family_energy_max,
+        ),
+        ("adapt", "adapt", f64::from(config.adapt)),
+        ("adapt_period", "adapt_period", config.adapt_period),
+        (
+            "adapt_realtime",
+            "adapt_realtime",
+            f64::from(config.adapt_realtime),
+        ),
+    ]
 }
 
-/// A C boolean field: 0 or 1.
-fn c_bool(name: &str, v: i32) -> Result<bool, String> {
-    match v {
-        0 | 1 => Ok(v == 1),
-        _ => Err(format!("{name} = {v} must be 0 or 1")),
+/// Names the config field of a message from the FMU's table.
+fn in_config_terms(message: String, fields: &[(&str, &str, f64)]) -> String {
+    match fields
+        .iter()
+        .find(|(_, name, _)| message.starts_with(&format!("{name} ")))
+    {
+        Some((field, name, _)) if field != name => format!("config.{field} ({name}): {message}"),
+        Some((field, _, _)) => format!("config.{field}: {message}"),
+        None => message,
     }
+}
+
+/// Checks a tunable as the controller FMU of `joints` joints does.
+fn check_tunable(joints: usize, name: &str, v: f64) -> Result<(), String> {
+    match joints {
+        3 => check_named::<EigenMpc3, 3>(name, v),
+        _ => check_named::<EigenMpc2, 2>(name, v),
+    }
+}
+
+fn settings_from(config: &EigenMpcConfig) -> Result<Settings<2>, String> {
+    let fields = named_fields(config);
+    let pairs: Vec<(&str, f64)> = fields.iter().map(|&(_, name, v)| (name, v)).collect();
+    settings_from_named::<EigenMpc2, 2>(&pairs).map_err(|e| in_config_terms(e, &fields))
 }
 
 fn tuning_from(config: &EigenMpcConfig) -> Tuning {
@@ -311,7 +348,7 @@ pub unsafe extern "C" fn eigenmpc_create(
 ) -> *mut EigenMpc {
     let result = catch_unwind(AssertUnwindSafe(|| -> Result<EigenMpc, String> {
         if config.is_null() {
-            return Err("eigenmpc_create: config is NULL".into());
+            return Err("config is NULL".into());
         }
         // SAFETY: non-null, and the caller guarantees it points to a config.
         let config = unsafe { &*config };
@@ -465,9 +502,13 @@ unsafe fn with_handle(mpc: *mut EigenMpc, body: impl FnOnce(&mut EigenMpc) -> i3
 pub unsafe extern "C" fn eigenmpc_set_e_ref(mpc: *mut EigenMpc, e_ref: f64) -> i32 {
     // SAFETY: forwarded caller guarantee.
     unsafe {
-        with_handle(mpc, |h| match h.controller.set_e_ref(e_ref) {
-            Ok(()) => 0,
-            Err(e) => h.fail(format!("eigenmpc_set_e_ref: {e}")),
+        with_handle(mpc, |h| {
+            let checked = check_tunable(h.controller.joints(), "E_ref", e_ref)
+                .and_then(|()| h.controller.set_e_ref(e_ref));
+            match checked {
+                Ok(()) => 0,
+                Err(e) => h.fail(format!("eigenmpc_set_e_ref: {e}")),
+            }
         })
     }
 }
@@ -488,6 +529,13 @@ pub unsafe extern "C" fn eigenmpc_set_tuning(
         with_handle(mpc, |h| {
             if config.is_null() {
                 return h.fail("eigenmpc_set_tuning: config is NULL".into());
+            }
+            let fields = named_fields(&*config);
+            // The tunables: e_ref .. w_f, checked by the FMU's table.
+            for &(field, name, v) in &fields[1..8] {
+                if let Err(e) = check_tunable(h.controller.joints(), name, v) {
+                    return h.fail(format!("eigenmpc_set_tuning: config.{field}: {e}"));
+                }
             }
             let cost = tuning_from(&*config).cost(h.variant);
             match h.controller.set_cost(cost) {

@@ -391,7 +391,7 @@ pub unsafe fn get_string<M: Model>(
     unsafe {
         call::<M>(c, F, |inst| match slice(vr, n) {
             Some(_) if n > 0 && value.is_null() => null(inst, F, "value"),
-            Some(vr) => inst.string_access(F, vr),
+            Some(vr) => inst.string_access(F, vr, false),
             None => null(inst, F, "vr"),
         })
     }
@@ -411,7 +411,7 @@ pub unsafe fn set_string<M: Model>(
     unsafe {
         call::<M>(c, F, |inst| match slice(vr, n) {
             Some(_) if n > 0 && value.is_null() => null(inst, F, "value"),
-            Some(vr) => inst.string_access(F, vr),
+            Some(vr) => inst.string_access(F, vr, true),
             None => null(inst, F, "vr"),
         })
     }
@@ -431,7 +431,7 @@ pub unsafe fn unsupported<M: Model>(
 
 /// A status query this FMU cannot answer (`fmi2GetStatus`,
 /// `fmi2GetIntegerStatus`, `fmi2GetStringStatus`): `fmi2Discard` with a
-/// warning line, the instance stays usable.
+/// warning line, the instance stays usable; a NULL `value` is an error.
 ///
 /// # Safety
 /// `c` as for [`call`].
@@ -439,8 +439,17 @@ pub unsafe fn status_unavailable<M: Model>(
     c: ffi::fmi2Component,
     func: &'static str,
     why: &'static str,
+    value_is_null: bool,
 ) -> ffi::fmi2Status {
-    unsafe { call::<M>(c, func, |inst| inst.status_unavailable(func, why)) }
+    unsafe {
+        call::<M>(c, func, |inst| {
+            if value_is_null {
+                null(inst, func, "value")
+            } else {
+                inst.status_unavailable(func, why)
+            }
+        })
+    }
 }
 
 /// `fmi2DoStep`.

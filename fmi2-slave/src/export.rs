@@ -282,9 +282,10 @@ macro_rules! export_fmi2 {
         const _: $crate::ffi::$ty = Some($name);
     };
 
-    (@status_unavailable $model:ty, $name:ident, $ty:ident, $why:literal, ($($arg:ident : $argty:ty),* $(,)?)) => {
+    (@status_unavailable $model:ty, $name:ident, $ty:ident, $why:literal, ($kind:ident : $kindty:ty, $value:ident : $valuety:ty)) => {
         /// A status this FMU cannot provide: returns `fmi2Discard` with a
         /// warning line (FMI 2.0 section 4.2.3); the instance stays usable.
+        /// A NULL `value` pointer is `fmi2Error`.
         ///
         /// # Safety
         /// `c` is null or a live instance of this FMU.
@@ -292,9 +293,12 @@ macro_rules! export_fmi2 {
         #[allow(non_snake_case)]
         pub unsafe extern "C" fn $name(
             c: $crate::ffi::fmi2Component,
-            $($arg: $argty),*
+            $kind: $kindty,
+            $value: $valuety,
         ) -> $crate::ffi::fmi2Status {
-            unsafe { $crate::abi::status_unavailable::<$model>(c, stringify!($name), $why) }
+            unsafe {
+                $crate::abi::status_unavailable::<$model>(c, stringify!($name), $why, $value.is_null())
+            }
         }
         const _: $crate::ffi::$ty = Some($name);
     };

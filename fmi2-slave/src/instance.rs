@@ -4,6 +4,7 @@
 
 use crate::logger::{Logger, Status};
 use crate::values::Values;
+use crate::variables::compact;
 use crate::variables::{BaseType, Causality, Initial, ModelDescription, Value, Variability};
 use std::fmt;
 
@@ -176,6 +177,9 @@ const READABLE: &[State] = &[
 ];
 
 /// States in which `fmi2Get*Status` may be called.
+/// Largest `|startTime|` accepted (s): time steps of 1 us still resolve.
+pub const MAX_START_TIME: f64 = 1e9;
+
 const STATUS_READABLE: &[State] = &[State::StepComplete, State::StepFailed, State::Terminated];
 
 impl<M: Model> Instance<M> {
@@ -295,23 +299,28 @@ impl<M: Model> Instance<M> {
             self.log.trace(|| {
                 format!("fmi2SetupExperiment(tolerance = {tolerance:?}, start = {start_time}, stop = {stop_time:?})")
             });
-            if !start_time.is_finite() {
+            if !(start_time.is_finite() && start_time.abs() <= MAX_START_TIME) {
                 return Err(format!(
-                    "fmi2SetupExperiment: startTime = {start_time} is not finite"
+                    "fmi2SetupExperiment: startTime = {start} must be finite and within \
+                     +-{MAX_START_TIME:e} s (beyond, a double cannot resolve the FMUs' time steps)",
+                    start = compact(start_time)
                 ));
             }
             if let Some(tol) = tolerance
                 && !(tol.is_finite() && tol > 0.0)
             {
                 return Err(format!(
-                    "fmi2SetupExperiment: tolerance = {tol} must be finite and > 0"
+                    "fmi2SetupExperiment: tolerance = {} must be finite and > 0",
+                    compact(tol)
                 ));
             }
             if let Some(stop) = stop_time
                 && !(stop.is_finite() && stop >= start_time)
             {
                 return Err(format!(
-                    "fmi2SetupExperiment: stopTime = {stop} must be finite and >= startTime = {start_time}"
+                    "fmi2SetupExperiment: stopTime = {} must be finite and >= startTime = {}",
+                    compact(stop),
+                    compact(start_time)
                 ));
             }
             self.experiment = Experiment {
@@ -595,13 +604,24 @@ impl<M: Model> Instance<M> {
 
     /// `fmi2GetString` / `fmi2SetString`: the models have no String
     /// variables, so any value reference is unknown.
-    pub fn string_access(&mut self, func: &'static str, vrs: &[u32]) -> Status {
-        let r = match vrs.first() {
+    pub fn string_access(&mut self, func: &'static str, vrs: &[u32], setter: bool) -> Status {
+        // The state check comes first, also for an empty call (nvr = 0):
+        // the states are those of the other getters and setters.
+        let states: &[State] = if setter {
+            &[
+                State::Instantiated,
+                State::InitializationMode,
+                State::StepComplete,
+            ]
+        } else {
+            READABLE
+        };
+        let r = self.require(func, states).and_then(|()| match vrs.first() {
             None => Ok(Status::Ok),
             Some(vr) => Err(format!(
                 "{func}: unknown String value reference {vr} (this FMU has no String variables)"
             )),
-        };
+        });
         self.conclude(r)
     }
 
@@ -614,14 +634,24 @@ impl<M: Model> Instance<M> {
             });
             if !(h.is_finite() && h > 0.0) {
                 return Err(format!(
-                    "fmi2DoStep: communicationStepSize = {h} must be finite and > 0"
+                    "fmi2DoStep: communicationStepSize = {} must be finite and > 0",
+                    compact(h)
+                ));
+            }
+            if t + h == t {
+                return Err(format!(
+                    "fmi2DoStep: communicationStepSize = {} does not advance the time t = {} \
+                     in double precision",
+                    compact(h),
+                    compact(t)
                 ));
             }
             if !t.is_finite() || (t - self.time).abs() > 1e-8 * t.abs().max(1.0) {
                 return Err(format!(
-                    "fmi2DoStep: currentCommunicationPoint = {t} differs from the FMU's time {} \
+                    "fmi2DoStep: currentCommunicationPoint = {} differs from the FMU's time {} \
                      (rolling back is not supported)",
-                    self.time
+                    compact(t),
+                    compact(self.time)
                 ));
             }
             let ctx = Context {

@@ -886,13 +886,7 @@ fn value_text(v: Value) -> String {
     }
 }
 
-/// The shorter of Rust's shortest round-trip decimal and exponent forms:
-/// `1e-6`, `9.81`, `2500`, `1e6`.
-pub fn compact(x: f64) -> String {
-    let plain = format!("{x}");
-    let exp = format!("{x:e}");
-    if exp.len() < plain.len() { exp } else { plain }
-}
+pub use crate::variables::compact;
 
 #[cfg(test)]
 mod tests {

@@ -294,12 +294,22 @@ impl Variable {
         if let Some(min) = self.min
             && x < min
         {
-            return Err(format!("{} = {x} is below its minimum {min}", self.name));
+            return Err(format!(
+                "{} = {} is below its minimum {}",
+                self.name,
+                compact(x),
+                compact(min)
+            ));
         }
         if let Some(max) = self.max
             && x > max
         {
-            return Err(format!("{} = {x} is above its maximum {max}", self.name));
+            return Err(format!(
+                "{} = {} is above its maximum {}",
+                self.name,
+                compact(x),
+                compact(max)
+            ));
         }
         Ok(())
     }
@@ -351,6 +361,8 @@ pub struct DefaultExperiment {
     pub stop_time: f64,
     /// Suggested communication step (s).
     pub step_size: f64,
+    /// Suggested relative tolerance of the FMU's integrator, if it has one.
+    pub tolerance: Option<f64>,
 }
 
 /// Everything the host learns from `modelDescription.xml`, as data.
@@ -467,4 +479,12 @@ impl ModelDescription {
         }
         Ok(())
     }
+}
+
+/// The shorter of Rust's shortest round-trip decimal and exponent forms, for
+/// messages: `1e300`, not three hundred digits.
+pub fn compact(x: f64) -> String {
+    let plain = format!("{x}");
+    let exp = format!("{x:e}");
+    if exp.len() < plain.len() { exp } else { plain }
 }

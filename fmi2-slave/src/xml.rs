@@ -180,9 +180,13 @@ fn render(d: &ModelDescription, guid: &str) -> String {
     }
     writeln!(w, "  </LogCategories>").unwrap();
     if let Some(e) = d.default_experiment {
+        let tolerance = e
+            .tolerance
+            .map(|t| format!(r#" tolerance="{}""#, real(t)))
+            .unwrap_or_default();
         writeln!(
             w,
-            r#"  <DefaultExperiment startTime="{}" stopTime="{}" stepSize="{}"/>"#,
+            r#"  <DefaultExperiment startTime="{}" stopTime="{}"{tolerance} stepSize="{}"/>"#,
             real(e.start_time),
             real(e.stop_time),
             real(e.step_size)

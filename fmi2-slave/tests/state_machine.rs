@@ -41,6 +41,7 @@ impl Model for Integrator {
                 start_time: 0.0,
                 stop_time: 1.0,
                 step_size: 0.1,
+                tolerance: None,
             }),
             units: vec![Unit::new("m", 0, 1, 0, 0)],
             enumerations: vec![],
@@ -720,4 +721,93 @@ fn table_is_valid_and_xml_lists_structure() {
     let mut bad = d;
     bad.variables[2].start = Some(Value::Real(200.0));
     assert!(bad.validate().unwrap_err().contains("above its maximum"));
+}
+
+/// `fmi2GetString` / `fmi2SetString` check the state before anything else,
+/// also with `nvr = 0`: the getter is an error before initialization, the
+/// setter after termination; both are fine where the other accessors are.
+#[test]
+fn string_accessors_check_the_state_even_when_empty() {
+    let get = |fmu: &Fmu| unsafe { fmi2GetString(fmu.c, ptr::null(), 0, ptr::null_mut()) };
+    let set = |fmu: &Fmu| unsafe { fmi2SetString(fmu.c, ptr::null(), 0, ptr::null()) };
+    let fmu = Fmu::new();
+    assert_eq!(get(&fmu), ERROR, "getter in state instantiated");
+    assert!(
+        fmu.log
+            .contains(&["fmi2GetString", "not allowed in state instantiated"])
+    );
+    unsafe { assert_eq!(fmi2Reset(fmu.c), OK) };
+    assert_eq!(set(&fmu), OK, "setter in state instantiated");
+    assert_eq!(get(&fmu), ERROR, "getter after reset");
+    unsafe { assert_eq!(fmi2Reset(fmu.c), OK) };
+    fmu.init();
+    assert_eq!((get(&fmu), set(&fmu)), (OK, OK), "step complete");
+    unsafe { assert_eq!(fmi2Terminate(fmu.c), OK) };
+    assert_eq!(get(&fmu), OK, "getter after terminate");
+    assert_eq!(set(&fmu), ERROR, "setter after terminate");
+    assert!(
+        fmu.log
+            .contains(&["fmi2SetString", "not allowed in state terminated"])
+    );
+}
+
+/// The status queries this FMU cannot answer return fmi2Discard, but a NULL
+/// `value` pointer is an error.
+#[test]
+fn unavailable_status_queries_with_a_null_value_are_errors() {
+    let fmu = Fmu::new();
+    fmu.init();
+    assert_eq!(fmu.step(0.0, 0.1), OK);
+    let kind = ffi::fmi2StatusKind_fmi2PendingStatus;
+    unsafe {
+        let mut status: ffi::fmi2Status = OK;
+        assert_eq!(fmi2GetStatus(fmu.c, kind, &mut status), DISCARD);
+        assert_eq!(fmi2GetStatus(fmu.c, kind, ptr::null_mut()), ERROR);
+        assert_eq!(fmi2Reset(fmu.c), OK);
+        fmu.init();
+        assert_eq!(fmu.step(0.0, 0.1), OK);
+        let mut i = 0;
+        assert_eq!(fmi2GetIntegerStatus(fmu.c, kind, &mut i), DISCARD);
+        assert_eq!(fmi2GetIntegerStatus(fmu.c, kind, ptr::null_mut()), ERROR);
+        assert_eq!(fmi2Reset(fmu.c), OK);
+        fmu.init();
+        assert_eq!(fmu.step(0.0, 0.1), OK);
+        let mut text: ffi::fmi2String = ptr::null();
+        assert_eq!(fmi2GetStringStatus(fmu.c, kind, &mut text), DISCARD);
+        assert_eq!(fmi2GetStringStatus(fmu.c, kind, ptr::null_mut()), ERROR);
+    }
+    assert!(
+        fmu.log
+            .contains(&["fmi2GetStringStatus", "value is a NULL pointer"])
+    );
+}
+
+/// A start time at which a double cannot resolve the time steps is refused
+/// with a message, and so is a step that does not advance the time.
+#[test]
+fn start_times_and_steps_that_cannot_advance_are_refused() {
+    for start in [1e15, -1e300, f64::INFINITY] {
+        let fmu = Fmu::new();
+        let status = unsafe { fmi2SetupExperiment(fmu.c, 0, 0.0, start, 0, 0.0) };
+        assert_eq!(status, ERROR, "startTime {start}");
+        assert!(
+            fmu.log
+                .contains(&["startTime", "must be finite and within"])
+        );
+    }
+    let fmu = Fmu::new();
+    unsafe {
+        assert_eq!(fmi2SetupExperiment(fmu.c, 0, 0.0, 1e8, 0, 0.0), OK);
+        assert_eq!(fmi2EnterInitializationMode(fmu.c), OK);
+        assert_eq!(fmi2ExitInitializationMode(fmu.c), OK);
+    }
+    assert_eq!(fmu.step(1e8, 1e-12), ERROR);
+    assert!(fmu.log.contains(&["does not advance the time"]));
+    unsafe { assert_eq!(fmi2Reset(fmu.c), OK) };
+    unsafe {
+        assert_eq!(fmi2SetupExperiment(fmu.c, 0, 0.0, 1e8, 0, 0.0), OK);
+        assert_eq!(fmi2EnterInitializationMode(fmu.c), OK);
+        assert_eq!(fmi2ExitInitializationMode(fmu.c), OK);
+    }
+    assert_eq!(fmu.step(1e8, 0.1), OK);
 }

@@ -178,7 +178,9 @@ pub fn point_mass_rows<S: HasChain<N>, const N: usize>(whose: &str) -> Vec<Row<S
                 |s, e, v| s.chain_mut().length[e.j] = v,
             ))
             .unit("m")
-            .range(1e-6, 1e3)
+            // Shorter links swing so fast (sqrt(g / l)) that one step of
+            // the plant's integrator takes seconds.
+            .range(1e-3, 1e3)
             .describe(format!("{whose}length of link {{j}}, joint to joint"))
             .group(MODEL_GROUP),
         Row::<S>::real("g", Shape::Scalar)

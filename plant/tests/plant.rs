@@ -564,3 +564,73 @@ fn starts_from_rest_for_every_accepted_tolerance() {
     }
     println!("start from rest: worst error / allowed = {worst:.2e}");
 }
+
+/// A master's tolerance (`fmi2SetupExperiment` with `toleranceDefined`)
+/// becomes the integrator's relative tolerance while `rtol` is at its start
+/// value (the run equals one with `rtol` set to it); a set `rtol` wins.
+/// The default experiment declares the default tolerance.
+#[test]
+fn the_masters_tolerance_sets_rtol_unless_rtol_was_set() {
+    let d = DoublePendulumFmu::description();
+    let default_rtol = d.default_experiment.unwrap().tolerance.unwrap();
+    assert_eq!(
+        d.variable("rtol").unwrap().start,
+        Some(fmi2_slave::Value::Real(default_rtol))
+    );
+    let tau_vr = [vref("tau[1]"), vref("tau[2]")];
+    let run = |rtol: Option<f64>, tolerance: Option<f64>| {
+        let fmu = Fmu::instantiate();
+        if let Some(r) = rtol {
+            assert_eq!(fmu.set(&[vref("rtol")], &[r]), OK);
+        }
+        unsafe {
+            let (defined, tol) = tolerance.map_or((0, 0.0), |t| (1, t));
+            assert_eq!(fmi2SetupExperiment(fmu.c, defined, tol, 0.0, 0, 0.0), OK);
+            assert_eq!(fmi2EnterInitializationMode(fmu.c), OK);
+            assert_eq!(fmi2ExitInitializationMode(fmu.c), OK);
+        }
+        assert_eq!(fmu.set(&tau_vr, &[0.7, -0.4]), OK);
+        for k in 0..40 {
+            assert_eq!(unsafe { fmi2DoStep(fmu.c, k as f64 * 0.025, 0.025, 1) }, OK);
+        }
+        fmu.outputs()
+    };
+    let default = run(None, None);
+    let loose = run(None, Some(1e-4));
+    let loose_param = run(Some(1e-4), None);
+    assert_eq!(loose, loose_param, "the master's tolerance is rtol");
+    assert_ne!(
+        loose, default,
+        "a loose tolerance changes the result (the test can fail)"
+    );
+    let set = run(Some(1e-10), Some(1e-4));
+    let set_alone = run(Some(1e-10), None);
+    assert_eq!(
+        set, set_alone,
+        "a set rtol wins over the master's tolerance"
+    );
+}
+
+/// A communication step the integrator cannot cover within its step budget
+/// is discarded with the reason (bounded work per call), and the instance
+/// reports how far it got.
+#[test]
+fn an_enormous_step_is_discarded_with_bounded_work() {
+    let fmu = Fmu::start(&[(vref("q0[1]"), 1.0)]);
+    let started = std::time::Instant::now();
+    let status = unsafe { fmi2DoStep(fmu.c, 0.0, 1e9, 1) };
+    let elapsed = started.elapsed().as_secs_f64();
+    assert_eq!(status, ffi::fmi2Status_fmi2Discard);
+    assert!(
+        fmu.instance
+            .log
+            .contains(&["at most 100000 integrator steps per fmi2DoStep"]),
+        "{:?}",
+        fmu.instance.log.lines()
+    );
+    let mut last = f64::NAN;
+    let kind = ffi::fmi2StatusKind_fmi2LastSuccessfulTime;
+    assert_eq!(unsafe { fmi2GetRealStatus(fmu.c, kind, &mut last) }, OK);
+    assert!(last > 0.0 && last < 1e9, "{last}");
+    eprintln!("discarded after {elapsed:.2} s at t = {last:.1} s");
+}

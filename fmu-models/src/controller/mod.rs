@@ -53,6 +53,9 @@ pub trait ControllerProduct<const N: usize>: 'static {
     }
 }
 
+/// Unsuccessful solves between two logged ones.
+pub const FAILURE_LOG_EVERY: usize = 100;
+
 /// Value references the sample path reads and writes.
 #[derive(Clone, Debug)]
 struct Io<const N: usize> {
@@ -113,6 +116,9 @@ pub struct ControllerFmu<P, const N: usize, const NX: usize, const NP: usize> {
     solved_at: f64,
     /// Model updates already reported.
     updates_reported: usize,
+    /// Solves that did not succeed (logged: the first and every
+    /// [`FAILURE_LOG_EVERY`]-th).
+    failed_solves: usize,
     settings: Settings<N>,
     table: Table<Settings<N>>,
     io: Io<N>,
@@ -138,6 +144,8 @@ pub fn description<P: ControllerProduct<N>, const N: usize>() -> ModelDescriptio
             start_time: 0.0,
             stop_time: 30.0,
             step_size: MpcConfig::paper(Variant::Curved).dt,
+            // No integrator: a master's tolerance does not apply.
+            tolerance: None,
         }),
         units: units::used_by(&variables),
         enumerations: t.enumerations(),
@@ -177,6 +185,7 @@ impl<P: ControllerProduct<N> + Send, const N: usize, const NX: usize, const NP: 
             controller,
             solved_at: ctx.experiment.start_time,
             updates_reported: 0,
+            failed_solves: 0,
             clock: SampleClock::new(ctx.experiment.start_time, settings.sample_period),
             settings,
             table,
@@ -273,12 +282,23 @@ impl<P, const N: usize, const NX: usize, const NP: usize> ControllerFmu<P, N, NX
         self.solved_at = t;
         self.solved_state = z;
         if !out.status.is_ok() {
-            // Failure path only: the message allocates.
-            ctx.log.warning(&format!(
-                "t = {t} s: {}; tau = {:?} N.m",
-                out.status,
-                out.tau.as_slice()
-            ));
+            self.failed_solves += 1;
+            // A state no bounded torque recovers from can fail most
+            // samples: log the first and then every FAILURE_LOG_EVERY-th
+            // (failure path only: the message allocates).
+            let n = self.failed_solves;
+            if n == 1 || n.is_multiple_of(FAILURE_LOG_EVERY) {
+                ctx.log.warning(&format!(
+                    "t = {t} s: {}; tau = ({}) N.m; {n} unsuccessful solve(s) so far (logged: \
+                     the first and every {FAILURE_LOG_EVERY}th; solver_status has each)",
+                    out.status,
+                    out.tau
+                        .iter()
+                        .map(|v| format!("{v:.6}"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ));
+            }
         }
         let energy = self.controller.controller().energy(&z);
         self.write_outputs(values, &out, energy);

@@ -22,31 +22,50 @@ pub fn settings_from_named<P: ControllerProduct<N>, const N: usize>(
     let d = description::<P, N>();
     let mut current = Values::new(&d);
     for &(name, x) in values {
-        let v = d
-            .variable(name)
-            .ok_or_else(|| format!("{name} is not a variable of {}", P::MODEL_NAME))?;
-        if v.causality != Causality::Parameter {
-            return Err(format!(
-                "{name} is not a parameter (it is set or read while running)"
-            ));
-        }
-        let base = v.var_type.base();
-        let value = match base {
-            BaseType::Real => Value::Real(x),
-            BaseType::Boolean if x == 0.0 || x == 1.0 => Value::Boolean(x == 1.0),
-            BaseType::Boolean => return Err(format!("{name} = {x} must be 0 or 1 (Boolean)")),
-            _ if x.fract() == 0.0 && x.abs() <= i32::MAX as f64 => Value::Integer(x as i32),
-            _ => return Err(format!("{name} = {x} must be an integer")),
-        };
-        v.check_value(value)?;
+        let (v, value) = checked(&d, P::MODEL_NAME, name, x)?;
         let index = current
-            .index(base, v.value_reference)
+            .index(v.var_type.base(), v.value_reference)
             .ok_or_else(|| format!("{name}: no value slot"))?;
         current.set_at(index, value);
     }
     let mut settings = P::settings(Variant::Curved);
     table::table::<N>().read(&current, &mut settings, |_| true);
     Ok(settings)
+}
+
+/// Checks `name = x` as `fmi2Set*` would for product `P` (a value for a
+/// tunable set later, e.g. by the C API's `eigenmpc_set_e_ref`).
+pub fn check_named<P: ControllerProduct<N>, const N: usize>(
+    name: &str,
+    x: f64,
+) -> Result<(), String> {
+    checked(&description::<P, N>(), P::MODEL_NAME, name, x).map(|_| ())
+}
+
+/// The parameter `name` of `d` and `x` as its value, checked.
+fn checked<'d>(
+    d: &'d fmi2_slave::ModelDescription,
+    model: &str,
+    name: &str,
+    x: f64,
+) -> Result<(&'d fmi2_slave::Variable, Value), String> {
+    let v = d
+        .variable(name)
+        .ok_or_else(|| format!("{name} is not a variable of {model}"))?;
+    if v.causality != Causality::Parameter {
+        return Err(format!(
+            "{name} is not a parameter (it is set or read while running)"
+        ));
+    }
+    let value = match v.var_type.base() {
+        BaseType::Real => Value::Real(x),
+        BaseType::Boolean if x == 0.0 || x == 1.0 => Value::Boolean(x == 1.0),
+        BaseType::Boolean => return Err(format!("{name} = {x} must be 0 or 1 (Boolean)")),
+        _ if x.fract() == 0.0 && x.abs() <= i32::MAX as f64 => Value::Integer(x as i32),
+        _ => return Err(format!("{name} = {x} must be an integer")),
+    };
+    v.check_value(value)?;
+    Ok((v, value))
 }
 
 #[cfg(test)]

@@ -11,6 +11,9 @@ use eigenmpc::mpc::{
     prediction_substeps,
 };
 
+/// Longest horizon the clarabel QP backend is offered for.
+pub const CLARABEL_MAX_HORIZON: usize = 200;
+
 /// Number of chart coefficients per joint (powers `0..=9`, the paper's degree).
 pub const CHART_COEFFICIENTS: usize = 10;
 
@@ -263,6 +266,17 @@ impl<const N: usize> Settings<N> {
     /// A computed curved reference continues the mode family at creation
     /// (tens of milliseconds for 2 links, see `cargo bench --bench modes`).
     pub fn build<const NX: usize>(&self) -> Result<ChainController<N, NX>, String> {
+        if self.qp == QpBackend::Clarabel && self.horizon > CLARABEL_MAX_HORIZON {
+            // Its sparse solves grow faster than N: seconds per sample at
+            // N = 1000, an unbounded call for a real-time controller.
+            return Err(format!(
+                "horizon = {} with qp_solver = clarabel: at most {CLARABEL_MAX_HORIZON} \
+                 (clarabel's time per sample grows faster than the horizon; riccati is linear \
+                 in it and takes up to {})",
+                self.horizon,
+                eigenmpc::mpc::MAX_HORIZON
+            ));
+        }
         let system = self.system()?;
         let mut config = self.config();
         // A model with Coulomb friction needs RK4 substeps to predict its

@@ -54,6 +54,7 @@ pub fn table<const N: usize>() -> Table<Settings<N>> {
         Rw::<N>::real("q", Shape::Joints)
             .input(0.0)
             .unit("rad")
+            .range(-1e9, 1e9)
             .describe(
                 "Measured angle of joint {j} (q[1] from the downward vertical, q[j] of link j \
                  relative to link j-1); a solve uses the value set for its communication point",
@@ -62,6 +63,8 @@ pub fn table<const N: usize>() -> Table<Settings<N>> {
         Rw::<N>::real("qd", Shape::Joints)
             .input(0.0)
             .unit("rad/s")
+            // Keeps the energy output finite (qd = 1e308 overflowed it).
+            .range(-1e6, 1e6)
             .describe(
                 "Measured speed of joint {j}; a solve uses the value set for its communication \
                  point",
@@ -91,15 +94,19 @@ pub fn table<const N: usize>() -> Table<Settings<N>> {
         Rw::<N>::integer("solver_status", Shape::Scalar)
             .output()
             .describe(
-                "Status of the last solve: 0 solved; 1 first-sample SQP not converged \
-                 (torque from the last iterate); 2 QP failed (torque = fallback: previous \
-                 plan's next control, clipped). 3 (invalid state) only occurs through the \
-                 C API: the FMU refuses NaN/Inf inputs with fmi2Error",
+                "Status of the last solve: 0 solved; 1 cold-start SQP not converged (the \
+                 first sample, or the first after a failed QP reset the plan; torque from \
+                 the last iterate); 2 QP failed (torque = fallback: previous plan's next \
+                 control, clipped; logged as a warning the first time and every 100th). 3 \
+                 (invalid state) only occurs through the C API: the FMU refuses NaN/Inf \
+                 inputs with fmi2Error",
             )
             .summary(
-                "0 solved; 1 first-sample SQP not converged; 2 QP failed (fallback torque = \
-                 previous plan's next control, clipped, and a logged warning); 3 invalid state \
-                 occurs only through the C API: the FMU refuses NaN/Inf inputs with fmi2Error",
+                "0 solved; 1 cold-start SQP not converged (first sample, or first after a \
+                 failed QP reset the plan); 2 QP failed (fallback torque = previous plan's \
+                 next control, clipped; warning logged the first time and every 100th); 3 \
+                 invalid state occurs only through the C API: the FMU refuses NaN/Inf inputs \
+                 with fmi2Error",
             ),
         Rw::<N>::enumeration(VARIANT.parameter, Shape::Scalar, VARIANT.fmi_type())
             .parameter(Field::integer(
@@ -170,7 +177,10 @@ pub fn table<const N: usize>() -> Table<Settings<N>> {
                 |s, _, v| s.horizon = v.max(0) as usize,
             ))
             .range(1.0, eigenmpc::mpc::MAX_HORIZON as f64)
-            .describe("Shooting intervals N of the prediction horizon"),
+            .describe(
+                "Shooting intervals N of the prediction horizon (with qp_solver = clarabel at \
+                 most 200)",
+            ),
         Rw::<N>::real("sample_period", Shape::Scalar)
             .parameter(Field::real(
                 |s, _| s.sample_period,

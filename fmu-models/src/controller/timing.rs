@@ -1,7 +1,9 @@
 //! When the controller solves: at the communication points on its sample
 //! grid `t_start + k sample_period`, or at the first communication point
-//! after a grid point that falls inside a step (warned once); a step longer
-//! than the sample period gets one solve per step (warned once).
+//! after a grid point that falls inside a step; a step longer than the
+//! sample period gets one solve per step. Both are documented behaviour:
+//! logged once under `logStatusWarning`, and the call returns `fmi2OK`
+//! (some masters stop at the first `fmi2Warning`).
 
 use fmi2_slave::Logger;
 
@@ -50,7 +52,7 @@ impl SampleClock {
         let dt = self.sample_period;
         if h > dt * (1.0 + GRID_TOLERANCE) && !self.warned_long_step {
             self.warned_long_step = true;
-            log.warning(&format!(
+            log.notice(&format!(
                 "communication step {h} s is longer than the sample period {dt} s: one solve \
                  per step (the prediction still assumes {dt} s intervals)"
             ));
@@ -62,7 +64,7 @@ impl SampleClock {
         if reached >= self.next_sample {
             if !on_grid && !self.warned_off_grid && h <= dt * (1.0 + GRID_TOLERANCE) {
                 self.warned_off_grid = true;
-                log.warning(&format!(
+                log.notice(&format!(
                     "communication point t = {t} s is not on the sample grid (start {} s, \
                      period {dt} s): solving at the first communication point after each grid \
                      point",

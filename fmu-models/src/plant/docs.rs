@@ -14,7 +14,9 @@ friction <code>b[j]</code> (also settable as <code>damping[j]</code>), smooth Co
 <code>cf[j] atan(coulomb_sharpness qd[j])</code> and a spring (<code>k[j]</code>, \
 <code>q_rest[j]</code>). The inputs are the joint torques <code>tau[j]</code>, held constant \
 over a communication step. <code>fmi2DoStep</code> integrates with an adaptive Dormand-Prince \
-5(4) method (tolerances <code>rtol</code>, <code>atol</code>), so the result does not depend on \
+5(4) method (tolerances <code>rtol</code>, <code>atol</code>; a master's \
+<code>fmi2SetupExperiment</code> tolerance sets <code>rtol</code> while that parameter is at its \
+start value), so the result does not depend on \
 the communication step size; <code>energy</code> is the total mechanical energy (zero at rest \
 at the stable equilibrium).</p>"
     )

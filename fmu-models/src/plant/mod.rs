@@ -21,6 +21,9 @@ use nalgebra::SVector;
 use settings::PlantSettings;
 use std::marker::PhantomData;
 
+/// Integrator steps one `fmi2DoStep` may take before it is discarded.
+pub const MAX_STEPS_PER_CALL: usize = 100_000;
+
 /// One plant FMU product: its name.
 pub trait PlantProduct<const N: usize>: 'static {
     /// `modelName` and `modelIdentifier`.
@@ -78,6 +81,8 @@ pub fn description<P: PlantProduct<N>, const N: usize>() -> ModelDescription {
             start_time: 0.0,
             stop_time: 10.0,
             step_size: 0.01,
+            // The integrator's default relative tolerance (rtol's start).
+            tolerance: Some(PlantSettings::<N>::default().tolerances.rtol),
         }),
         units: units::used_by(&variables),
         enumerations: t.enumerations(),
@@ -93,8 +98,20 @@ impl<P: PlantProduct<N>, const N: usize, const NX: usize> Model for PlantFmu<P, 
     fn initialize(values: &mut Values, ctx: &Context) -> Result<Self, ModelError> {
         let table = table::table::<N>();
         let io = Io::new(&table).map_err(ModelError::Error)?;
-        let mut settings = PlantSettings::<N>::default();
+        let defaults = PlantSettings::<N>::default();
+        let mut settings = defaults.clone();
         table.read(values, &mut settings, |_| true);
+        // A master's tolerance (fmi2SetupExperiment with toleranceDefined)
+        // sets the relative tolerance unless rtol itself was changed.
+        if let Some(tolerance) = ctx.experiment.tolerance
+            && settings.tolerances.rtol == defaults.tolerances.rtol
+        {
+            settings.tolerances.rtol = tolerance;
+            ctx.log.event(&format!(
+                "rtol = {tolerance} from fmi2SetupExperiment's tolerance (set the rtol parameter \
+                 to choose another)"
+            ));
+        }
         let system = settings.system().map_err(ModelError::Error)?;
         let z0 = SVector::<f64, NX>::from_fn(|i, _| {
             if i < N {
@@ -103,9 +120,12 @@ impl<P: PlantProduct<N>, const N: usize, const NX: usize> Model for PlantFmu<P, 
                 settings.qd0[i - N]
             }
         });
+        let mut ode = Dopri5::new(ctx.experiment.start_time, z0, settings.tolerances);
+        // Bounded work per call (about 0.3 s): a 25 ms step takes tens.
+        ode.max_steps = MAX_STEPS_PER_CALL;
         let model = Self {
             system,
-            ode: Dopri5::new(ctx.experiment.start_time, z0, settings.tolerances),
+            ode,
             tau: Vector::<N>::from_fn(|j, _| values.real(io.tau[j])),
             io,
             product: PhantomData,
@@ -133,9 +153,12 @@ impl<P: PlantProduct<N>, const N: usize, const NX: usize> Model for PlantFmu<P, 
             |_, z: &SVector<f64, NX>| state_derivative::<PlanarChain<N>, N, NX>(system, z, &tau),
             t + h,
         );
-        let result = result
-            .map(|_| ())
-            .map_err(|e| format!("integration failed: {e}"));
+        let result = result.map(|_| ()).map_err(|e| {
+            format!(
+                "integration failed: {e} (at most {MAX_STEPS_PER_CALL} integrator steps per \
+                 fmi2DoStep: take shorter communication steps)"
+            )
+        });
         self.write_outputs(values);
         result.map_err(|message| ModelError::Discard {
             message,

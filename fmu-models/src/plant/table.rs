@@ -57,11 +57,14 @@ pub fn table<const N: usize>() -> Table<PlantSettings<N>> {
         Rw::<N>::real("q0", Shape::Joints)
             .parameter(Field::real(|s, e| s.q0[e.j], |s, e, v| s.q0[e.j] = v))
             .unit("rad")
+            .range(-1e3, 1e3)
             .describe("Initial angle q[{j}]")
             .summary("initial angles"),
         Rw::<N>::real("qd0", Shape::Joints)
             .parameter(Field::real(|s, e| s.qd0[e.j], |s, e, v| s.qd0[e.j] = v))
             .unit("rad/s")
+            // Beyond any robot; keeps the energy and the work per step finite.
+            .range(-1e3, 1e3)
             .describe("Initial speed qd[{j}]")
             .summary("initial speeds"),
         Rw::<N>::real("rtol", Shape::Scalar)
@@ -70,7 +73,10 @@ pub fn table<const N: usize>() -> Table<PlantSettings<N>> {
                 |s, _, v| s.tolerances.rtol = v,
             ))
             .range(1e-14, 1e-2)
-            .describe("Relative tolerance of the adaptive integrator")
+            .describe(
+                "Relative tolerance of the adaptive integrator (at its start value, a tolerance \
+                 given to fmi2SetupExperiment is used instead)",
+            )
             .summary("integrator tolerances (relative)"),
         Rw::<N>::real("atol", Shape::Scalar)
             .parameter(Field::real(
