@@ -18,6 +18,7 @@ apt_install() {
 
 # fmi-sys runs bindgen on the FMI headers at build time: it needs libclang.
 dpkg -s libclang-dev >/dev/null 2>&1 || apt_install libclang-dev
-# The symbol test lists the FMU's exports with nm; cc-built crates need gcc.
-command -v nm >/dev/null 2>&1 || apt_install binutils
+# The symbol test lists the FMU's exports with nm; fmu-build strips the FMU
+# binaries with objcopy; cc-built crates need gcc.
+{ command -v nm && command -v objcopy; } >/dev/null 2>&1 || apt_install binutils
 command -v gcc >/dev/null 2>&1 || apt_install gcc

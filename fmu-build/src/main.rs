@@ -5,7 +5,8 @@
 //! `modelDescription.xml` from its variable table (also into the checked-in
 //! `modelDescription/`), zips `target/fmu/<modelIdentifier>.fmu`
 //! (`modelDescription.xml`, `binaries/linux64/<modelIdentifier>.so`,
-//! `documentation/index.html`), generates `include/eigenmpc.h` (the plain C
+//! `documentation/index.html`; the binary stripped of debug information,
+//! which is kept apart in `target/fmu/<modelIdentifier>.so.debug`), generates `include/eigenmpc.h` (the plain C
 //! API with cbindgen, config `cbindgen.toml`, and every FMU's value-reference
 //! and enumeration constants from its variable table) next to the standard
 //! FMI 2.0 headers, and rewrites the README's FMU variable tables from the
@@ -173,10 +174,41 @@ fn describe(ws: &Workspace, fmu: &FmuSpec) -> Result<(String, String)> {
     ))
 }
 
-fn package(ws: &Workspace, fmu: &FmuSpec, xml: &str, html: &str) -> Result<PathBuf> {
+/// The FMU's binary without debug information (the release profile keeps
+/// it for profiling: 20-26 MB against 2-3 MB), which goes to
+/// `target/fmu/<modelIdentifier>.so.debug`, linked by `.gnu_debuglink` for
+/// debuggers. Needs binutils' `objcopy` (Debian `binutils`, installed with
+/// gcc by `tests/run.sh`).
+fn stripped_binary(ws: &Workspace, fmu: &FmuSpec) -> Result<Vec<u8>> {
     let library = ws.target.join("release").join(fmu.library);
+    let dir = ws.target.join("fmu");
+    let debug = dir.join(format!("{}.so.debug", fmu.model_identifier));
+    let stripped = dir.join(format!("{}.so", fmu.model_identifier));
+    let objcopy = |args: &[&std::ffi::OsStr]| -> Result<()> {
+        let status = Command::new("objcopy")
+            .args(args)
+            .status()
+            .context("running objcopy (Debian package binutils) to strip the FMU binary")?;
+        if !status.success() {
+            bail!("objcopy {args:?} failed");
+        }
+        Ok(())
+    };
+    objcopy(&["--only-keep-debug".as_ref(), library.as_os_str(), debug.as_os_str()])?;
+    objcopy(&[
+        "--strip-unneeded".as_ref(),
+        format!("--add-gnu-debuglink={}", debug.display()).as_ref(),
+        library.as_os_str(),
+        stripped.as_os_str(),
+    ])?;
     let binary =
-        std::fs::read(&library).with_context(|| format!("reading {}", library.display()))?;
+        std::fs::read(&stripped).with_context(|| format!("reading {}", stripped.display()))?;
+    std::fs::remove_file(&stripped)?;
+    Ok(binary)
+}
+
+fn package(ws: &Workspace, fmu: &FmuSpec, xml: &str, html: &str) -> Result<PathBuf> {
+    let binary = stripped_binary(ws, fmu)?;
     let path = ws
         .target
         .join("fmu")
