@@ -194,7 +194,11 @@ fn stripped_binary(ws: &Workspace, fmu: &FmuSpec) -> Result<Vec<u8>> {
         }
         Ok(())
     };
-    objcopy(&["--only-keep-debug".as_ref(), library.as_os_str(), debug.as_os_str()])?;
+    objcopy(&[
+        "--only-keep-debug".as_ref(),
+        library.as_os_str(),
+        debug.as_os_str(),
+    ])?;
     objcopy(&[
         "--strip-unneeded".as_ref(),
         format!("--add-gnu-debuglink={}", debug.display()).as_ref(),
