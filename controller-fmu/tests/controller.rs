@@ -1153,3 +1153,62 @@ fn input_ranges_and_rate_limited_failure_warnings() {
     assert_eq!(statuses.iter().filter(|&&s| s == WARNING).count(), 3);
     assert!(statuses.iter().all(|&s| s == OK || s == WARNING));
 }
+
+/// `fmi2Reset` and the same run again equal a fresh instance bit for bit
+/// (fmpy's loops and its Dask example reset between runs), also with the
+/// adaptation's worker and estimate in play.
+#[test]
+fn reset_then_the_same_run_equals_a_fresh_instance() {
+    use eigenmpc::integrate::{Dopri5, Tolerances};
+    use eigenmpc::mechanics::{PlanarChain, PlanarChainParams, state_derivative};
+    let plant = PlanarChain::new(PlanarChainParams::<2>::point_masses(
+        [1.0, 1.2],
+        [1.0, 1.0],
+        9.81,
+    ))
+    .unwrap();
+    // Parameters and inputs of one run from instantiation; the torque trace.
+    let run = |fmu: &mut Fmu| -> Vec<[f64; 2]> {
+        let on: ffi::fmi2Boolean = 1;
+        assert_eq!(unsafe { fmi2SetBoolean(fmu.c, &vref("adapt"), 1, &on) }, OK);
+        assert_eq!(fmu.set(&[vref("adapt_period")], &[0.25]), OK);
+        unsafe {
+            assert_eq!(fmi2SetupExperiment(fmu.c, 0, 0.0, 0.0, 0, 0.0), OK);
+            assert_eq!(fmi2EnterInitializationMode(fmu.c), OK);
+            assert_eq!(fmu.set(&state(), &Z0), OK);
+            assert_eq!(fmi2ExitInitializationMode(fmu.c), OK);
+        }
+        fmu.t = 0.0;
+        let tol = Tolerances {
+            rtol: 1e-10,
+            atol: 1e-10,
+        };
+        let mut ode = Dopri5::new(0.0, SVector::<f64, 4>::from(Z0), tol);
+        let mut taus = vec![];
+        for k in 0..160 {
+            let z = *ode.state();
+            if k > 0 {
+                assert_eq!(fmu.set(&state(), z.as_slice()), OK);
+            }
+            assert_eq!(fmu.step(DT), OK);
+            let tau = fmu.tau();
+            taus.push(tau);
+            let tau = Vector::<2>::from(tau);
+            ode.advance_to(
+                |_, z| state_derivative::<_, 2, 4>(&plant, z, &tau),
+                (k + 1) as f64 * DT,
+            )
+            .unwrap();
+        }
+        assert!(fmu.integer(vref("model_updates")) > 0);
+        taus
+    };
+    let mut fresh = Fmu::instantiate();
+    let first = run(&mut fresh);
+    assert_eq!(unsafe { fmi2Reset(fresh.c) }, OK);
+    let again = run(&mut fresh);
+    let mut other = Fmu::instantiate();
+    let new = run(&mut other);
+    assert_eq!(first, again, "after fmi2Reset");
+    assert_eq!(first, new, "a fresh instance");
+}

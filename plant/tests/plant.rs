@@ -634,3 +634,33 @@ fn an_enormous_step_is_discarded_with_bounded_work() {
     assert!(last > 0.0 && last < 1e9, "{last}");
     eprintln!("discarded after {elapsed:.2} s at t = {last:.1} s");
 }
+
+/// `fmi2Reset` and the same run again equal a fresh instance bit for bit:
+/// the integrator's step size and first-same-as-last stage start afresh.
+#[test]
+fn reset_then_the_same_run_equals_a_fresh_instance() {
+    let run = |fmu: &mut Fmu| -> Vec<[f64; 5]> {
+        assert_eq!(fmu.set(&[vref("q0[1]"), vref("b[2]")], &[1.2, 0.03]), OK);
+        unsafe {
+            assert_eq!(fmi2SetupExperiment(fmu.c, 0, 0.0, 0.0, 0, 0.0), OK);
+            assert_eq!(fmi2EnterInitializationMode(fmu.c), OK);
+            assert_eq!(fmi2ExitInitializationMode(fmu.c), OK);
+        }
+        fmu.t = 0.0;
+        (0..80)
+            .map(|k| {
+                let tau = [0.3 * (k as f64 * 0.1).sin(), -0.2];
+                assert_eq!(fmu.set(&[vref("tau[1]"), vref("tau[2]")], &tau), OK);
+                fmu.step(0.025);
+                fmu.outputs()
+            })
+            .collect()
+    };
+    let mut fmu = Fmu::instantiate();
+    let first = run(&mut fmu);
+    assert_eq!(unsafe { fmi2Reset(fmu.c) }, OK);
+    let again = run(&mut fmu);
+    let new = run(&mut Fmu::instantiate());
+    assert_eq!(first, again, "after fmi2Reset");
+    assert_eq!(first, new, "a fresh instance");
+}
