@@ -61,7 +61,8 @@ pub struct EigenMpcConfig {
     pub w_f: f64,
     /// Torque bound |tau_j| <= tau_max (N m), > 0.
     pub tau_max: f64,
-    /// Shooting intervals N of the horizon, 1..=1000 (`eigenmpc::mpc::MAX_HORIZON`).
+    /// Shooting intervals N of the horizon, 1..=1000 (`eigenmpc::mpc::MAX_HORIZON`; at most
+    /// 200 with the clarabel QP solver).
     pub horizon: u32,
     /// Sample period and shooting interval (s), > 0.
     pub sample_period: f64,
