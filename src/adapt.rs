@@ -51,6 +51,7 @@ impl Default for AdaptOptions {
 
 /// A request to the worker: the model's parameters and, for a controller
 /// on a mode family, the family's options and mode.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 struct Request<const N: usize> {
     params: PlanarChainParams<N>,
     family: Option<(FamilyOptions, usize)>,
@@ -64,9 +65,11 @@ type Computed<const N: usize> = (PlanarChain<N>, Option<ChartFamily<N>>, usize);
 
 /// What the worker and the sample path share.
 struct Slot<const N: usize> {
-    request: Option<Request<N>>,
-    /// The worker's answer (Err: the model or its family failed).
-    result: Option<Result<Computed<N>, ()>>,
+    /// A request and its generation.
+    request: Option<(u64, Request<N>)>,
+    /// The worker's answer to the request of a generation (Err: the model
+    /// or its family failed).
+    result: Option<(u64, Result<Computed<N>, ()>)>,
     /// A family the controller no longer uses, for the worker to free.
     garbage: Option<ChartFamily<N>>,
     quit: bool,
@@ -83,6 +86,11 @@ pub struct Adaptation<const N: usize, const NX: usize, const NP: usize> {
     /// Base parameters of the model the worker is computing.
     posted: SVector<f64, NP>,
     pending: bool,
+    /// The request the worker is computing (kept for a saved state).
+    request: Option<Request<N>>,
+    /// Answers to requests of another generation are dropped: a restored
+    /// state ([`Adaptation::restore_state`]) starts a new one.
+    generation: u64,
     /// Requests whose model or family could not be computed.
     failures: usize,
     samples: usize,
@@ -121,6 +129,8 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
             in_use,
             posted: in_use,
             pending: false,
+            request: None,
+            generation: 0,
             failures: 0,
             samples: 0,
             updates: 0,
@@ -173,7 +183,10 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
         let (lock, wake) = &*self.shared;
         let mut slot = if self.options.synchronous {
             let Ok(mut slot) = lock.lock() else { return };
-            while self.pending && slot.result.is_none() {
+            while self.pending && !matches!(&slot.result, Some((g, _)) if *g == self.generation) {
+                if slot.result.is_some() {
+                    self.drop_stale(&mut slot);
+                }
                 slot = match wake.wait(slot) {
                     Ok(s) => s,
                     Err(_) => return,
@@ -186,8 +199,12 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
             let Ok(slot) = lock.try_lock() else { return };
             slot
         };
-        if let Some(result) = slot.result.take() {
+        if matches!(&slot.result, Some((g, _)) if *g != self.generation) {
+            self.drop_stale(&mut slot);
+        }
+        if let Some((_, result)) = slot.result.take() {
             self.pending = false;
+            self.request = None;
             // A failed model or family (or one this controller cannot
             // take) leaves the model in use; a later estimate may succeed.
             let replaced = result.map(|(model, family, substeps)| {
@@ -237,14 +254,87 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
             }
             None => None,
         };
-        slot.request = Some(Request {
+        let request = Request {
             params,
             family,
             dt: controller.config().dt,
-        });
+        };
+        // Copies of plain data: no allocation.
+        slot.request = Some((self.generation, request.clone()));
+        self.request = Some(request);
         self.posted = estimate.theta;
         self.pending = true;
         wake.notify_one();
+    }
+}
+
+/// The state of an [`Adaptation`] between two samples
+/// ([`Adaptation::save_state`]).
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct AdaptationState<const N: usize, const NP: usize> {
+    rls: EnergyBalanceRls<N, NP>,
+    in_use: SVector<f64, NP>,
+    posted: SVector<f64, NP>,
+    /// The request the worker was computing (posted again on restore).
+    request: Option<Request<N>>,
+    failures: usize,
+    samples: usize,
+    updates: usize,
+}
+
+impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
+    /// A stale answer (of a generation before a restore) goes to the
+    /// worker's garbage, or is dropped when that is taken.
+    fn drop_stale(&self, slot: &mut Slot<N>) {
+        if let Some((_, Ok((_, family @ Some(_), _)))) = slot.result.take()
+            && slot.garbage.is_none()
+        {
+            slot.garbage = family;
+        }
+    }
+
+    /// Everything the next samples depend on: the identification, the
+    /// model in use and a request in flight. With `synchronous` (offline
+    /// simulation), a restored adaptation continues bit for bit.
+    pub fn save_state(&self) -> AdaptationState<N, NP> {
+        AdaptationState {
+            rls: self.rls.clone(),
+            in_use: self.in_use,
+            posted: self.posted,
+            request: if self.pending {
+                self.request.clone()
+            } else {
+                None
+            },
+            failures: self.failures,
+            samples: self.samples,
+            updates: self.updates,
+        }
+    }
+
+    /// Continues from `state` (saved by an adaptation with the same
+    /// prior and options): a request in flight is posted again, answers
+    /// the worker is still computing for the state before are dropped.
+    pub fn restore_state(&mut self, state: AdaptationState<N, NP>) -> Result<(), IdentifyError> {
+        self.rls.check_compatible(&state.rls)?;
+        let (lock, wake) = &*self.shared;
+        let mut slot = lock.lock().unwrap_or_else(|e| e.into_inner());
+        self.generation += 1;
+        slot.request = state
+            .request
+            .clone()
+            .map(|request| (self.generation, request));
+        slot.result = None;
+        self.pending = state.request.is_some();
+        self.request = state.request;
+        self.rls = state.rls;
+        self.in_use = state.in_use;
+        self.posted = state.posted;
+        self.failures = state.failures;
+        self.samples = state.samples;
+        self.updates = state.updates;
+        wake.notify_all();
+        Ok(())
     }
 }
 
@@ -270,7 +360,7 @@ fn work<const N: usize, const NX: usize>(shared: &(Mutex<Slot<N>>, Condvar)) {
         if slot.quit {
             return;
         }
-        if let Some(request) = slot.request.take() {
+        if let Some((generation, request)) = slot.request.take() {
             drop(slot);
             let computed = PlanarChain::new(request.params)
                 .ok()
@@ -292,7 +382,7 @@ fn work<const N: usize, const NX: usize>(shared: &(Mutex<Slot<N>>, Condvar)) {
                 Ok(s) => s,
                 Err(_) => return,
             };
-            slot.result = Some(computed);
+            slot.result = Some((generation, computed));
             wake.notify_all();
             continue;
         }

@@ -285,7 +285,7 @@ pub fn friction_features<const N: usize, const NP: usize>(
 }
 
 /// Settings of the recursive least squares.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct RlsOptions {
     /// Forgetting factor per window, in (0, 1] (1: no forgetting).
     pub forgetting: f64,
@@ -320,7 +320,7 @@ impl Default for RlsOptions {
 /// Energy-balance identification by recursive least squares, fed one
 /// sample at a time (measured `q`, `qd` and the torque applied over the
 /// previous sample); fixed size, no allocation.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct EnergyBalanceRls<const N: usize, const NP: usize> {
     prior: PlanarChainParams<N>,
     options: RlsOptions,
@@ -369,6 +369,24 @@ impl<const N: usize, const NP: usize> EnergyBalanceRls<N, NP> {
         BaseParameters {
             theta: self.estimate,
         }
+    }
+
+    /// Whether `saved` (a saved state) belongs to an identification with
+    /// this prior and these options, with a finite estimate.
+    pub fn check_compatible(&self, saved: &Self) -> Result<(), IdentifyError> {
+        if saved.prior != self.prior || saved.options != self.options {
+            return Err(IdentifyError::NotPhysical(
+                "the saved identification has another prior or other options".into(),
+            ));
+        }
+        if !(saved.estimate.iter().all(|v| v.is_finite())
+            && saved.covariance.iter().all(|v| v.is_finite()))
+        {
+            return Err(IdentifyError::NotPhysical(
+                "the saved identification is not finite".into(),
+            ));
+        }
+        Ok(())
     }
 
     /// Drops the open window (a gap in the measurements, a restart): the

@@ -168,7 +168,7 @@ where
 }
 
 /// Tolerances of the adaptive integrator.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Tolerances {
     /// Relative tolerance.
     pub rtol: f64,
@@ -245,8 +245,9 @@ const E7: f64 = -1.0 / 40.0;
 
 /// Adaptive Dormand-Prince 5(4) integrator that keeps its state between
 /// calls, so a caller can advance it in chunks (co-simulation steps, path
-/// samples) without losing the step size or the FSAL stage.
-#[derive(Clone, Debug)]
+/// samples) without losing the step size or the FSAL stage. Serializable
+/// (an FMU's saved state): a restored integrator continues bit for bit.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Dopri5<S: OdeState> {
     t: f64,
     y: S,

@@ -8,6 +8,7 @@
 use crate::ffi;
 use crate::instance::{Instance, Model};
 use crate::logger::{Logger, Status};
+use crate::state::{self, FmuState};
 use crate::variables::BaseType;
 use std::any::Any;
 use std::ffi::{CStr, c_char};
@@ -518,6 +519,205 @@ pub unsafe fn get_boolean_status<M: Model>(
                     Status::Ok
                 }
                 Err(s) => s,
+            }
+        })
+    }
+}
+
+/// The live state behind a host's `fmi2FMUstate`, or the reason it is none.
+fn live_state<'a>(s: ffi::fmi2FMUstate) -> Result<&'a FmuState, &'static str> {
+    let p = s as *const FmuState;
+    if p.is_null() {
+        Err("argument FMUstate is a NULL pointer")
+    } else if !state::is_live(p) {
+        Err("FMUstate is not a live state of this FMU (freed, or from elsewhere)")
+    } else {
+        // SAFETY: live states are boxes this library allocated and has not freed.
+        Ok(unsafe { &*p })
+    }
+}
+
+/// Stores `saved` in the host's `*out`: into the live state already there
+/// (FMI 2.0: a non-NULL `*FMUstate` is overwritten), else a new one.
+///
+/// # Safety
+/// `out` is non-null and writable.
+unsafe fn store_state(out: *mut ffi::fmi2FMUstate, saved: FmuState) -> Result<(), &'static str> {
+    // SAFETY: see the function's contract.
+    let current = unsafe { *out } as *mut FmuState;
+    if current.is_null() {
+        unsafe { *out = state::into_raw(saved) as ffi::fmi2FMUstate };
+        Ok(())
+    } else if state::is_live(current) {
+        // SAFETY: live, allocated by this library.
+        unsafe { *current = saved };
+        Ok(())
+    } else {
+        Err("*FMUstate is neither NULL nor a live state of this FMU")
+    }
+}
+
+/// `fmi2GetFMUstate`.
+///
+/// # Safety
+/// `c` as for [`call`]; `s` null or writable.
+pub unsafe fn get_fmu_state<M: Model>(
+    c: ffi::fmi2Component,
+    s: *mut ffi::fmi2FMUstate,
+) -> ffi::fmi2Status {
+    const F: &str = "fmi2GetFMUstate";
+    unsafe {
+        call::<M>(c, F, |inst| {
+            if s.is_null() {
+                return null(inst, F, "FMUstate");
+            }
+            match inst.save_state(F) {
+                Ok(saved) => match store_state(s, saved) {
+                    Ok(()) => Status::Ok,
+                    Err(e) => inst.state_argument_error(&format!("{F}: {e}")),
+                },
+                Err(status) => status,
+            }
+        })
+    }
+}
+
+/// `fmi2SetFMUstate`.
+///
+/// # Safety
+/// `c` as for [`call`].
+pub unsafe fn set_fmu_state<M: Model>(
+    c: ffi::fmi2Component,
+    s: ffi::fmi2FMUstate,
+) -> ffi::fmi2Status {
+    const F: &str = "fmi2SetFMUstate";
+    unsafe {
+        call::<M>(c, F, |inst| match live_state(s) {
+            Ok(saved) => {
+                let saved = saved.clone();
+                inst.restore_state(F, &saved)
+            }
+            Err(e) => inst.state_argument_error(&format!("{F}: {e}")),
+        })
+    }
+}
+
+/// `fmi2FreeFMUstate`: frees `*s` and sets it to NULL (`*s == NULL`: nothing).
+///
+/// # Safety
+/// `c` as for [`call`]; `s` null or writable.
+pub unsafe fn free_fmu_state<M: Model>(
+    c: ffi::fmi2Component,
+    s: *mut ffi::fmi2FMUstate,
+) -> ffi::fmi2Status {
+    const F: &str = "fmi2FreeFMUstate";
+    unsafe {
+        call::<M>(c, F, |inst| {
+            if s.is_null() {
+                return null(inst, F, "FMUstate");
+            }
+            let p = *s as *mut FmuState;
+            if p.is_null() {
+                return inst.state_call_ok(F);
+            }
+            if state::free(p) {
+                *s = ptr::null_mut();
+                inst.state_call_ok(F)
+            } else {
+                inst.state_argument_error(&format!(
+                    "{F}: *FMUstate is not a live state of this FMU (freed twice, or from elsewhere)"
+                ))
+            }
+        })
+    }
+}
+
+/// `fmi2SerializedFMUstateSize`.
+///
+/// # Safety
+/// `c` as for [`call`]; `size` null or writable.
+pub unsafe fn serialized_fmu_state_size<M: Model>(
+    c: ffi::fmi2Component,
+    s: ffi::fmi2FMUstate,
+    size: *mut usize,
+) -> ffi::fmi2Status {
+    const F: &str = "fmi2SerializedFMUstateSize";
+    unsafe {
+        call::<M>(c, F, |inst| {
+            if size.is_null() {
+                return null(inst, F, "size");
+            }
+            match live_state(s) {
+                Ok(saved) => {
+                    *size = saved.bytes().len();
+                    inst.state_call_ok(F)
+                }
+                Err(e) => inst.state_argument_error(&format!("{F}: {e}")),
+            }
+        })
+    }
+}
+
+/// `fmi2SerializeFMUstate`: writes the state into `bytes[..size]`; `size`
+/// must be at least [`serialized_fmu_state_size`]'s.
+///
+/// # Safety
+/// `c` as for [`call`]; `bytes` null or `size` writable bytes.
+pub unsafe fn serialize_fmu_state<M: Model>(
+    c: ffi::fmi2Component,
+    s: ffi::fmi2FMUstate,
+    bytes: *mut ffi::fmi2Byte,
+    size: usize,
+) -> ffi::fmi2Status {
+    const F: &str = "fmi2SerializeFMUstate";
+    unsafe {
+        call::<M>(c, F, |inst| {
+            let saved = match live_state(s) {
+                Ok(saved) => saved,
+                Err(e) => return inst.state_argument_error(&format!("{F}: {e}")),
+            };
+            let n = saved.bytes().len();
+            if size < n {
+                return inst.state_argument_error(&format!(
+                    "{F}: the buffer has {size} bytes, the state needs {n} \
+                     (fmi2SerializedFMUstateSize)"
+                ));
+            }
+            let Some(out) = slice_mut(bytes as *mut u8, n) else {
+                return null(inst, F, "serializedState");
+            };
+            out.copy_from_slice(saved.bytes());
+            inst.state_call_ok(F)
+        })
+    }
+}
+
+/// `fmi2DeSerializeFMUstate`: a new state (or the live one in `*s`) from
+/// `bytes[..size]`, checked before anything is stored.
+///
+/// # Safety
+/// `c` as for [`call`]; `bytes` null or `size` readable bytes; `s` null or writable.
+pub unsafe fn deserialize_fmu_state<M: Model>(
+    c: ffi::fmi2Component,
+    bytes: *const ffi::fmi2Byte,
+    size: usize,
+    s: *mut ffi::fmi2FMUstate,
+) -> ffi::fmi2Status {
+    const F: &str = "fmi2DeSerializeFMUstate";
+    unsafe {
+        call::<M>(c, F, |inst| {
+            if s.is_null() {
+                return null(inst, F, "FMUstate");
+            }
+            let Some(input) = slice(bytes as *const u8, size) else {
+                return null(inst, F, "serializedState");
+            };
+            match inst.deserialize_state(F, input) {
+                Ok(saved) => match store_state(s, saved) {
+                    Ok(()) => Status::Ok,
+                    Err(e) => inst.state_argument_error(&format!("{F}: {e}")),
+                },
+                Err(status) => status,
             }
         })
     }

@@ -13,9 +13,10 @@
 /// }
 /// ```
 ///
-/// FMU state handling, directional derivatives, input/output derivatives and
-/// asynchronous steps are not supported: those functions return `fmi2Error`
-/// with a log line naming the function.
+/// The FMU state functions work when the model's description sets
+/// `can_save_state` (else `fmi2Error`). Directional derivatives,
+/// input/output derivatives and asynchronous steps are not supported: those
+/// functions return `fmi2Error` with a log line naming the function.
 #[macro_export]
 macro_rules! export_fmi2 {
     ($model:ty) => {
@@ -179,18 +180,18 @@ macro_rules! export_fmi2 {
         $crate::export_fmi2!(@getset $model, fmi2SetBoolean, fmi2SetBooleanTYPE, set_boolean, *const __ffi::fmi2Boolean);
         $crate::export_fmi2!(@getset $model, fmi2SetString, fmi2SetStringTYPE, set_string, *const __ffi::fmi2String);
 
-        $crate::export_fmi2!(@unsupported $model, fmi2GetFMUstate, fmi2GetFMUstateTYPE,
-            "canGetAndSetFMUstate is false", (_s: *mut __ffi::fmi2FMUstate));
-        $crate::export_fmi2!(@unsupported $model, fmi2SetFMUstate, fmi2SetFMUstateTYPE,
-            "canGetAndSetFMUstate is false", (_s: __ffi::fmi2FMUstate));
-        $crate::export_fmi2!(@unsupported $model, fmi2FreeFMUstate, fmi2FreeFMUstateTYPE,
-            "canGetAndSetFMUstate is false", (_s: *mut __ffi::fmi2FMUstate));
-        $crate::export_fmi2!(@unsupported $model, fmi2SerializedFMUstateSize, fmi2SerializedFMUstateSizeTYPE,
-            "canSerializeFMUstate is false", (_s: __ffi::fmi2FMUstate, _size: *mut usize));
-        $crate::export_fmi2!(@unsupported $model, fmi2SerializeFMUstate, fmi2SerializeFMUstateTYPE,
-            "canSerializeFMUstate is false", (_s: __ffi::fmi2FMUstate, _bytes: *mut __ffi::fmi2Byte, _size: usize));
-        $crate::export_fmi2!(@unsupported $model, fmi2DeSerializeFMUstate, fmi2DeSerializeFMUstateTYPE,
-            "canSerializeFMUstate is false", (_bytes: *const __ffi::fmi2Byte, _size: usize, _s: *mut __ffi::fmi2FMUstate));
+        $crate::export_fmi2!(@state $model, fmi2GetFMUstate, fmi2GetFMUstateTYPE, get_fmu_state,
+            (s: *mut __ffi::fmi2FMUstate));
+        $crate::export_fmi2!(@state $model, fmi2SetFMUstate, fmi2SetFMUstateTYPE, set_fmu_state,
+            (s: __ffi::fmi2FMUstate));
+        $crate::export_fmi2!(@state $model, fmi2FreeFMUstate, fmi2FreeFMUstateTYPE, free_fmu_state,
+            (s: *mut __ffi::fmi2FMUstate));
+        $crate::export_fmi2!(@state $model, fmi2SerializedFMUstateSize, fmi2SerializedFMUstateSizeTYPE,
+            serialized_fmu_state_size, (s: __ffi::fmi2FMUstate, size: *mut usize));
+        $crate::export_fmi2!(@state $model, fmi2SerializeFMUstate, fmi2SerializeFMUstateTYPE,
+            serialize_fmu_state, (s: __ffi::fmi2FMUstate, bytes: *mut __ffi::fmi2Byte, size: usize));
+        $crate::export_fmi2!(@state $model, fmi2DeSerializeFMUstate, fmi2DeSerializeFMUstateTYPE,
+            deserialize_fmu_state, (bytes: *const __ffi::fmi2Byte, size: usize, s: *mut __ffi::fmi2FMUstate));
         $crate::export_fmi2!(@unsupported $model, fmi2GetDirectionalDerivative, fmi2GetDirectionalDerivativeTYPE,
             "providesDirectionalDerivative is false",
             (_u: *const __ffi::fmi2ValueReference, _nu: usize, _k: *const __ffi::fmi2ValueReference,
@@ -299,6 +300,22 @@ macro_rules! export_fmi2 {
             unsafe {
                 $crate::abi::status_unavailable::<$model>(c, stringify!($name), $why, $value.is_null())
             }
+        }
+        const _: $crate::ffi::$ty = Some($name);
+    };
+
+    (@state $model:ty, $name:ident, $ty:ident, $func:ident, ($($arg:ident : $argty:ty),* $(,)?)) => {
+        /// FMU state save and restore (see `fmi2_slave::state`).
+        ///
+        /// # Safety
+        /// Arguments as the FMI 2.0 standard defines them.
+        #[unsafe(no_mangle)]
+        #[allow(non_snake_case)]
+        pub unsafe extern "C" fn $name(
+            c: $crate::ffi::fmi2Component,
+            $($arg: $argty),*
+        ) -> $crate::ffi::fmi2Status {
+            unsafe { $crate::abi::$func::<$model>(c, $($arg),*) }
         }
         const _: $crate::ffi::$ty = Some($name);
     };

@@ -3,13 +3,14 @@
 //! Rust API; [`crate::abi`] wraps it for C.
 
 use crate::logger::{Logger, Status};
+use crate::state::{self, FmuState, ModelSnapshot, Snapshot};
 use crate::values::Values;
 use crate::variables::compact;
 use crate::variables::{BaseType, Causality, Initial, ModelDescription, Value, Variability};
 use std::fmt;
 
 /// The FMI 2.0 Co-Simulation states an instance can be in.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum State {
     /// After `fmi2Instantiate` or `fmi2Reset`.
     Instantiated,
@@ -41,7 +42,7 @@ impl fmt::Display for State {
 }
 
 /// Settings of `fmi2SetupExperiment`.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Experiment {
     /// Tolerance requested by the host, if any.
     pub tolerance: Option<f64>,
@@ -119,6 +120,30 @@ pub trait Model: Sized + Send + 'static {
         ctx: &Context,
     ) -> Result<(), ModelError>;
 
+    /// Everything a later step depends on beyond the values (the FMU state
+    /// of `fmi2GetFMUstate`), as bytes for [`Model::restore_state`]. Only
+    /// called when the description sets `can_save_state`. May allocate.
+    fn save_state(&self) -> Result<Vec<u8>, ModelError> {
+        Err(ModelError::Error("this model cannot save its state".into()))
+    }
+
+    /// Takes over a state from [`Model::save_state`] of a model that was
+    /// initialized from the same values (this one, or one just built from
+    /// them); `values` are the restored values. After it, the model
+    /// continues bit for bit as the one that saved the state. Bad bytes
+    /// (a crafted buffer: the plumbing has checked the checksum) are an error.
+    fn restore_state(
+        &mut self,
+        state: &[u8],
+        values: &Values,
+        ctx: &Context,
+    ) -> Result<(), ModelError> {
+        let _ = (state, values, ctx);
+        Err(ModelError::Error(
+            "this model cannot restore a state".into(),
+        ))
+    }
+
     /// Tunable parameters changed between steps: validate and take them over.
     /// On error the plumbing restores the previous values.
     fn update_tunables(&mut self, values: &mut Values, ctx: &Context) -> Result<(), ModelError> {
@@ -131,9 +156,13 @@ pub trait Model: Sized + Send + 'static {
 pub struct Instance<M: Model> {
     log: Logger,
     description: ModelDescription,
+    guid: String,
     values: Values,
     state: State,
     model: Option<M>,
+    /// The values `model` was initialized from (a saved state rebuilds the
+    /// model from them in a fresh instance).
+    initial_values: Option<Vec<Value>>,
     /// In initialization mode: `model` reflects the current values.
     model_current: bool,
     experiment: Experiment,
@@ -207,9 +236,11 @@ impl<M: Model> Instance<M> {
         Some(Self {
             log,
             description,
+            guid: expected,
             values,
             state: State::Instantiated,
             model: None,
+            initial_values: None,
             model_current: false,
             experiment: Experiment::default(),
             time: 0.0,
@@ -353,8 +384,10 @@ impl<M: Model> Instance<M> {
             log: &self.log,
             experiment: &self.experiment,
         };
+        let initial_values = self.values.all().to_vec();
         let model = M::initialize(&mut self.values, &ctx).map_err(|e| format!("{func}: {e}"))?;
         self.model = Some(model);
+        self.initial_values = Some(initial_values);
         self.model_current = true;
         Ok(())
     }
@@ -391,6 +424,7 @@ impl<M: Model> Instance<M> {
     pub fn reset(&mut self) -> Status {
         self.values = Values::new(&self.description);
         self.model = None;
+        self.initial_values = None;
         self.model_current = false;
         self.experiment = Experiment::default();
         self.time = 0.0;
@@ -729,6 +763,179 @@ impl<M: Model> Instance<M> {
             );
             Status::Discard
         });
+        self.conclude(r)
+    }
+}
+
+/// FMU state save and restore ([`crate::state`] has the byte form).
+impl<M: Model> Instance<M> {
+    fn require_state_support(&self, func: &str) -> Result<(), String> {
+        if self.description.can_save_state {
+            Ok(())
+        } else {
+            Err(format!(
+                "{func}: not supported: canGetAndSetFMUstate is false"
+            ))
+        }
+    }
+
+    /// `fmi2GetFMUstate` (and the state `fmi2SerializeFMUstate` writes):
+    /// the serialized state of this instance. Allowed in every state.
+    pub fn save_state(&mut self, func: &str) -> Result<FmuState, Status> {
+        let r = (|| {
+            self.require_state_support(func)?;
+            // In initialization mode the model is rebuilt when needed (it
+            // is a function of the values); after it, it carries the run.
+            let model = match (&self.model, &self.initial_values) {
+                (Some(model), Some(initial)) if self.state != State::InitializationMode => {
+                    Some(ModelSnapshot {
+                        initial_values: initial.clone(),
+                        state: model.save_state().map_err(|e| format!("{func}: {e}"))?,
+                    })
+                }
+                _ => None,
+            };
+            let snapshot = Snapshot {
+                state: self.state,
+                values: self.values.all().to_vec(),
+                experiment: self.experiment,
+                time: self.time,
+                last_successful_time: self.last_successful_time,
+                terminate_requested: self.terminate_requested,
+                model,
+            };
+            let payload = postcard::to_allocvec(&snapshot)
+                .map_err(|e| format!("{func}: cannot encode the state: {e}"))?;
+            Ok(FmuState {
+                bytes: state::encode(&self.guid, &payload),
+            })
+        })();
+        match r {
+            Ok(saved) => {
+                self.log.event(&format!(
+                    "{func}: state at t = {} saved ({} bytes)",
+                    self.time,
+                    saved.bytes.len()
+                ));
+                self.conclude(Ok(Status::Ok));
+                Ok(saved)
+            }
+            Err(e) => Err(self.conclude(Err(e))),
+        }
+    }
+
+    /// Decodes and checks a serialized state of this FMU (header, payload,
+    /// the values against the variable table).
+    fn decode_state(&self, bytes: &[u8]) -> Result<(Snapshot, Values), String> {
+        let payload = state::decode(&self.guid, bytes)?;
+        let snapshot: Snapshot =
+            postcard::from_bytes(payload).map_err(|e| format!("malformed state payload: {e}"))?;
+        let values = Values::from_saved(&self.description, &snapshot.values)
+            .map_err(|e| format!("malformed state values: {e}"))?;
+        let needs_model = matches!(
+            snapshot.state,
+            State::StepComplete | State::StepFailed | State::Terminated
+        );
+        if needs_model && snapshot.model.is_none() {
+            return Err(format!(
+                "malformed state: state {} without its model",
+                snapshot.state
+            ));
+        }
+        if let Some(m) = &snapshot.model {
+            Values::from_saved(&self.description, &m.initial_values)
+                .map_err(|e| format!("malformed initial values: {e}"))?;
+        }
+        if !(snapshot.time.is_finite() && snapshot.last_successful_time.is_finite()) {
+            return Err("malformed state: time is not finite".into());
+        }
+        Ok((snapshot, values))
+    }
+
+    /// `fmi2DeSerializeFMUstate`: a state from its serialized form, checked
+    /// (a buffer of another FMU, format version, or a corrupt one is an error).
+    pub fn deserialize_state(&mut self, func: &str, bytes: &[u8]) -> Result<FmuState, Status> {
+        let r = self
+            .require_state_support(func)
+            .and_then(|()| self.decode_state(bytes).map_err(|e| format!("{func}: {e}")));
+        match r {
+            Ok(_) => {
+                self.conclude(Ok(Status::Ok));
+                Ok(FmuState {
+                    bytes: bytes.to_vec(),
+                })
+            }
+            Err(e) => Err(self.conclude(Err(e))),
+        }
+    }
+
+    /// `fmi2SetFMUstate`: continues from `saved` (also after `fmi2Error`).
+    /// The model is restored in place when it was initialized from the same
+    /// values in the same experiment, else rebuilt from them first.
+    pub fn restore_state(&mut self, func: &str, saved: &FmuState) -> Status {
+        let r = (|| {
+            self.require_state_support(func)?;
+            let (snapshot, values) = self
+                .decode_state(&saved.bytes)
+                .map_err(|e| format!("{func}: {e}"))?;
+            let ctx = Context {
+                log: &self.log,
+                experiment: &snapshot.experiment,
+            };
+            let model = match &snapshot.model {
+                None => None,
+                Some(m) => {
+                    let same = self.initial_values.as_ref() == Some(&m.initial_values)
+                        && self.experiment == snapshot.experiment;
+                    let mut model = match self.model.take() {
+                        Some(model) if same => model,
+                        current => {
+                            // A failed rebuild leaves the current model.
+                            self.model = current;
+                            let mut initial =
+                                Values::from_saved(&self.description, &m.initial_values)?;
+                            M::initialize(&mut initial, &ctx)
+                                .map_err(|e| format!("{func}: rebuilding the model: {e}"))?
+                        }
+                    };
+                    if let Err(e) = model.restore_state(&m.state, &values, &ctx) {
+                        // Keep the model so that the instance can still be
+                        // reset; the error state forbids stepping it.
+                        self.model = Some(model);
+                        self.initial_values = Some(m.initial_values.clone());
+                        return Err(format!("{func}: {e}"));
+                    }
+                    Some(model)
+                }
+            };
+            self.model_current = model.is_some();
+            self.model = model;
+            self.initial_values = snapshot.model.map(|m| m.initial_values);
+            self.values = values;
+            self.state = snapshot.state;
+            self.experiment = snapshot.experiment;
+            self.time = snapshot.time;
+            self.last_successful_time = snapshot.last_successful_time;
+            self.terminate_requested = snapshot.terminate_requested;
+            self.log.event(&format!(
+                "{func}: state at t = {} restored (state {})",
+                self.time, self.state
+            ));
+            Ok(Status::Ok)
+        })();
+        self.conclude(r)
+    }
+
+    /// A state call with a bad argument (NULL, a pointer that is not a live
+    /// state, a buffer too small): `fmi2Error` with `message`.
+    pub fn state_argument_error(&mut self, message: &str) -> Status {
+        self.conclude(Err(message.to_string()))
+    }
+
+    /// A successful call that needs no instance data (`fmi2FreeFMUstate`,
+    /// `fmi2SerializedFMUstateSize`, `fmi2SerializeFMUstate`).
+    pub fn state_call_ok(&mut self, func: &str) -> Status {
+        let r = self.require_state_support(func).map(|()| Status::Ok);
         self.conclude(r)
     }
 }

@@ -13,6 +13,7 @@
 //! - [`table`]: declarative tables parameterised by the number of joints,
 //!   from which the variables, value references, settings, C constants and
 //!   Markdown tables follow;
+//! - [`state`]: FMU state save and restore, and its versioned byte form;
 //! - [`abi`]: the C entry points, generic over the model, with null checks
 //!   and `catch_unwind` (no panic crosses the C ABI);
 //! - [`export_fmi2!`]: generates all 34 FMI 2.0 common + Co-Simulation
@@ -29,6 +30,7 @@ pub mod abi;
 mod export;
 pub mod instance;
 pub mod logger;
+pub mod state;
 pub mod table;
 pub mod testing;
 pub mod values;

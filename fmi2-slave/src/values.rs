@@ -3,7 +3,7 @@
 //! checking them against the variable table); the model reads them and writes
 //! its outputs. Sized once at instantiation; access does not allocate.
 
-use crate::variables::{BaseType, ModelDescription, Value};
+use crate::variables::{BaseType, Causality, ModelDescription, Value};
 
 const NONE: u32 = u32::MAX;
 
@@ -42,6 +42,44 @@ impl Values {
             }));
         }
         Self { values, lookup }
+    }
+
+    /// All values, in the order of the variable table (FMU state).
+    pub(crate) fn all(&self) -> &[Value] {
+        &self.values
+    }
+
+    /// The store of `description` holding `values` (a saved state): each
+    /// value must have its variable's type, and parameters and inputs must
+    /// pass the variable's checks.
+    pub(crate) fn from_saved(
+        description: &ModelDescription,
+        values: &[Value],
+    ) -> Result<Self, String> {
+        if values.len() != description.variables.len() {
+            return Err(format!(
+                "{} values for {} variables",
+                values.len(),
+                description.variables.len()
+            ));
+        }
+        let mut store = Self::new(description);
+        for (i, (var, &value)) in description.variables.iter().zip(values).enumerate() {
+            let same_type = matches!(
+                (var.var_type.base(), value),
+                (BaseType::Real, Value::Real(_))
+                    | (BaseType::Integer, Value::Integer(_))
+                    | (BaseType::Boolean, Value::Boolean(_))
+            );
+            if !same_type {
+                return Err(format!("{} has type {:?}", var.name, var.var_type));
+            }
+            if matches!(var.causality, Causality::Parameter | Causality::Input) {
+                var.check_value(value)?;
+            }
+            store.values[i] = value;
+        }
+        Ok(store)
     }
 
     /// Index into the variable table of `(base, vr)`, if the reference exists.

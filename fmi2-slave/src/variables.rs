@@ -83,7 +83,7 @@ pub enum Initial {
 }
 
 /// A start or current value.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Value {
     /// Real value.
     Real(f64),
@@ -382,6 +382,9 @@ pub struct ModelDescription {
     pub generation_tool: String,
     /// Whether doStep accepts any communication step size.
     pub can_handle_variable_communication_step_size: bool,
+    /// Whether the model saves and restores its state ([`crate::Model::save_state`]):
+    /// `canGetAndSetFMUstate` and `canSerializeFMUstate`.
+    pub can_save_state: bool,
     /// Default experiment, if any.
     pub default_experiment: Option<DefaultExperiment>,
     /// Units used by the variables.

@@ -127,9 +127,11 @@ fn render(d: &ModelDescription, guid: &str) -> String {
     .unwrap();
     writeln!(
         w,
-        r#"  <CoSimulation modelIdentifier="{}" canHandleVariableCommunicationStepSize="{}" canInterpolateInputs="false" maxOutputDerivativeOrder="0" canRunAsynchronuously="false" canBeInstantiatedOnlyOncePerProcess="false" canNotUseMemoryManagementFunctions="true" canGetAndSetFMUstate="false" canSerializeFMUstate="false" providesDirectionalDerivative="false"/>"#,
+        r#"  <CoSimulation modelIdentifier="{}" canHandleVariableCommunicationStepSize="{}" canInterpolateInputs="false" maxOutputDerivativeOrder="0" canRunAsynchronuously="false" canBeInstantiatedOnlyOncePerProcess="false" canNotUseMemoryManagementFunctions="true" canGetAndSetFMUstate="{}" canSerializeFMUstate="{}" providesDirectionalDerivative="false"/>"#,
         escape(&d.model_identifier),
-        d.can_handle_variable_communication_step_size
+        d.can_handle_variable_communication_step_size,
+        d.can_save_state,
+        d.can_save_state
     )
     .unwrap();
     if !d.units.is_empty() {

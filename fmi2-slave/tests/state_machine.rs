@@ -37,6 +37,7 @@ impl Model for Integrator {
             author: "test".into(),
             generation_tool: "fmi2-slave tests".into(),
             can_handle_variable_communication_step_size: true,
+            can_save_state: true,
             default_experiment: Some(DefaultExperiment {
                 start_time: 0.0,
                 stop_time: 1.0,
@@ -114,6 +115,32 @@ impl Model for Integrator {
         self.steps += 1;
         values.set_real(X, self.x);
         values.set_integer(STEPS, self.steps);
+        Ok(())
+    }
+
+    fn save_state(&self) -> Result<Vec<u8>, ModelError> {
+        let mut out = self.x.to_le_bytes().to_vec();
+        out.extend_from_slice(&self.k.to_le_bytes());
+        out.extend_from_slice(&self.steps.to_le_bytes());
+        Ok(out)
+    }
+
+    fn restore_state(
+        &mut self,
+        state: &[u8],
+        _values: &Values,
+        _ctx: &Context,
+    ) -> Result<(), ModelError> {
+        if state.len() != 20 {
+            return Err(ModelError::Error(format!(
+                "{} state bytes, expected 20",
+                state.len()
+            )));
+        }
+        let f = |i: usize| f64::from_le_bytes(state[i..i + 8].try_into().unwrap());
+        self.x = f(0);
+        self.k = f(8);
+        self.steps = i32::from_le_bytes(state[16..20].try_into().unwrap());
         Ok(())
     }
 
@@ -567,14 +594,6 @@ fn a_panic_in_the_model_becomes_an_error() {
 fn unsupported_functions_are_errors_with_a_message() {
     let fmu = Fmu::new();
     fmu.init();
-    let mut state: ffi::fmi2FMUstate = ptr::null_mut();
-    assert_eq!(unsafe { fmi2GetFMUstate(fmu.c, &mut state) }, ERROR);
-    assert!(
-        fmu.log
-            .contains(&["fmi2GetFMUstate: not supported", "canGetAndSetFMUstate"])
-    );
-    let fmu = Fmu::new();
-    fmu.init();
     let (vr, order, v) = (U, 1, 0.0);
     assert_eq!(
         unsafe { fmi2SetRealInputDerivatives(fmu.c, &vr, 1, &order, &v) },
@@ -810,4 +829,309 @@ fn start_times_and_steps_that_cannot_advance_are_refused() {
         assert_eq!(fmi2ExitInitializationMode(fmu.c), OK);
     }
     assert_eq!(fmu.step(1e8, 0.1), OK);
+}
+
+// ---- FMU state: get/set/free/serialize/deserialize ----
+
+impl Fmu {
+    fn get_state(&self, state: &mut ffi::fmi2FMUstate) -> ffi::fmi2Status {
+        unsafe { fmi2GetFMUstate(self.c, state) }
+    }
+
+    fn set_state(&self, state: ffi::fmi2FMUstate) -> ffi::fmi2Status {
+        unsafe { fmi2SetFMUstate(self.c, state) }
+    }
+
+    fn free_state(&self, state: &mut ffi::fmi2FMUstate) -> ffi::fmi2Status {
+        unsafe { fmi2FreeFMUstate(self.c, state) }
+    }
+
+    fn serialize(&self, state: ffi::fmi2FMUstate) -> Vec<u8> {
+        let mut size = 0usize;
+        unsafe {
+            assert_eq!(fmi2SerializedFMUstateSize(self.c, state, &mut size), OK);
+            let mut bytes = vec![0u8; size];
+            assert_eq!(
+                fmi2SerializeFMUstate(self.c, state, bytes.as_mut_ptr() as *mut _, size),
+                OK
+            );
+            bytes
+        }
+    }
+
+    fn deserialize(&self, bytes: &[u8], state: &mut ffi::fmi2FMUstate) -> ffi::fmi2Status {
+        unsafe { fmi2DeSerializeFMUstate(self.c, bytes.as_ptr() as *const _, bytes.len(), state) }
+    }
+
+    /// `n` steps of `h` from `t` with u = 1 + 0.1 k (k: step index): the
+    /// x after each, as bits.
+    fn run(&self, t: f64, h: f64, n: usize) -> Vec<u64> {
+        (0..n)
+            .map(|k| {
+                assert_eq!(self.set_real(&[U], &[1.0 + 0.1 * k as f64]), OK);
+                assert_eq!(self.step(t + k as f64 * h, h), OK);
+                self.real(X).1.to_bits()
+            })
+            .collect()
+    }
+}
+
+#[test]
+fn a_restored_state_continues_bit_for_bit_here_in_a_fresh_instance_and_from_bytes() {
+    let h = 0.1; // not exact in binary: the rounding must continue identically
+    let fmu = Fmu::new();
+    fmu.init();
+    fmu.run(0.0, h, 7);
+    assert_eq!(fmu.set_real(&[K], &[3.5]), OK); // a tuned parameter is part of it
+    let mut saved: ffi::fmi2FMUstate = ptr::null_mut();
+    assert_eq!(fmu.get_state(&mut saved), OK);
+    assert!(!saved.is_null());
+    let t = 0.7000000000000001; // the FMU's time after 7 steps of 0.1
+    let reference = fmu.run(t, h, 9);
+
+    // The same instance.
+    assert_eq!(fmu.set_state(saved), OK);
+    assert_eq!(fmu.integer(STEPS), (OK, 7));
+    assert_eq!(fmu.run(t, h, 9), reference);
+
+    // Another instance of the same FMU in this process.
+    let other = Fmu::new();
+    assert_eq!(other.set_state(saved), OK);
+    assert_eq!(other.run(t, h, 9), reference);
+
+    // The serialized bytes, in a fresh instance.
+    let bytes = fmu.serialize(saved);
+    assert_eq!(&bytes[..8], b"EMPCSTAT");
+    let fresh = Fmu::new();
+    let mut loaded: ffi::fmi2FMUstate = ptr::null_mut();
+    assert_eq!(fresh.deserialize(&bytes, &mut loaded), OK);
+    assert_eq!(fresh.set_state(loaded), OK);
+    assert_eq!(fresh.real(K), (OK, 3.5));
+    assert_eq!(fresh.run(t, h, 9), reference);
+    // Serializing the loaded state gives the same bytes.
+    assert_eq!(fresh.serialize(loaded), bytes);
+
+    // A second get into the same handle overwrites it (FMI 2.0).
+    let before = saved;
+    assert_eq!(fmu.get_state(&mut saved), OK);
+    assert_eq!(saved, before);
+    assert_ne!(fmu.serialize(saved), bytes);
+
+    assert_eq!(fmu.free_state(&mut saved), OK);
+    assert!(saved.is_null());
+    assert_eq!(fresh.free_state(&mut loaded), OK);
+    // Freeing NULL is a no-op.
+    assert_eq!(fresh.free_state(&mut loaded), OK);
+}
+
+#[test]
+fn restoring_recovers_from_error_and_restores_the_state_machine() {
+    let fmu = Fmu::new();
+    let mut instantiated: ffi::fmi2FMUstate = ptr::null_mut();
+    assert_eq!(fmu.set_real(&[X0], &[4.0]), OK);
+    assert_eq!(fmu.get_state(&mut instantiated), OK);
+    fmu.init();
+    let mut running: ffi::fmi2FMUstate = ptr::null_mut();
+    assert_eq!(fmu.get_state(&mut running), OK);
+    // A panic puts the instance into the error state ...
+    let panic_at = [0];
+    unsafe { assert_eq!(fmi2Reset(fmu.c), OK) };
+    assert_eq!(
+        unsafe { fmi2SetInteger(fmu.c, &PANIC_AT, 1, panic_at.as_ptr()) },
+        OK
+    );
+    fmu.init();
+    assert_eq!(fmu.step(0.0, 0.5), ERROR);
+    assert_eq!(fmu.step(0.0, 0.5), ERROR);
+    // ... a saved state brings it back, with its own parameters.
+    assert_eq!(fmu.set_state(running), OK);
+    assert_eq!(fmu.real(X), (OK, 4.0));
+    assert_eq!(fmu.set_real(&[U], &[1.0]), OK);
+    assert_eq!(fmu.step(0.0, 0.5), OK);
+    assert_eq!(fmu.real(X), (OK, 5.0));
+    // A state saved before initialization returns to that state: only
+    // the calls of the instantiated state are allowed.
+    assert_eq!(fmu.set_state(instantiated), OK);
+    assert_eq!(fmu.step(0.5, 0.5), ERROR);
+    assert_eq!(fmu.set_state(instantiated), OK);
+    fmu.init();
+    assert_eq!(fmu.real(X), (OK, 4.0));
+    assert_eq!(fmu.free_state(&mut running), OK);
+    assert_eq!(fmu.free_state(&mut instantiated), OK);
+}
+
+#[test]
+fn bad_state_arguments_are_errors_with_a_message() {
+    let fmu = Fmu::new();
+    fmu.init();
+    let mut saved: ffi::fmi2FMUstate = ptr::null_mut();
+    assert_eq!(fmu.get_state(&mut saved), OK);
+    let bytes = fmu.serialize(saved);
+    unsafe {
+        assert_eq!(fmi2GetFMUstate(fmu.c, ptr::null_mut()), ERROR);
+        assert_eq!(fmi2SetFMUstate(fmu.c, ptr::null_mut()), ERROR);
+        let mut bogus = 0x1234usize as ffi::fmi2FMUstate;
+        assert_eq!(fmi2SetFMUstate(fmu.c, bogus), ERROR);
+        assert!(fmu.log.contains(&["not a live state"]));
+        assert_eq!(fmi2FreeFMUstate(fmu.c, &mut bogus), ERROR);
+        assert_eq!(fmi2GetFMUstate(fmu.c, &mut bogus), ERROR);
+        let mut size = 0;
+        assert_eq!(
+            fmi2SerializedFMUstateSize(fmu.c, saved, ptr::null_mut()),
+            ERROR
+        );
+        assert_eq!(fmi2SerializedFMUstateSize(fmu.c, bogus, &mut size), ERROR);
+        let mut small = vec![0u8; bytes.len() - 1];
+        assert_eq!(
+            fmi2SerializeFMUstate(fmu.c, saved, small.as_mut_ptr() as *mut _, small.len()),
+            ERROR
+        );
+        assert!(fmu.log.contains(&["the state needs"]));
+        let mut out: ffi::fmi2FMUstate = ptr::null_mut();
+        assert_eq!(
+            fmi2DeSerializeFMUstate(fmu.c, ptr::null(), 10, &mut out),
+            ERROR
+        );
+        assert!(out.is_null());
+        assert_eq!(
+            fmi2DeSerializeFMUstate(
+                fmu.c,
+                bytes.as_ptr() as *const _,
+                bytes.len(),
+                ptr::null_mut()
+            ),
+            ERROR
+        );
+    }
+    // A freed state is refused, not used.
+    let mut copy = saved;
+    assert_eq!(fmu.free_state(&mut saved), OK);
+    assert_eq!(fmu.set_state(copy), ERROR);
+    assert_eq!(fmu.free_state(&mut copy), ERROR);
+    assert!(fmu.log.contains(&["freed twice, or from elsewhere"]));
+}
+
+/// xorshift64*: a fixed, dependency-free random stream for the fuzz tests.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
+    }
+}
+
+/// Re-seals a payload under a valid header (so the fuzz reaches the payload
+/// decoder, not just the checksum).
+fn seal(bytes: &[u8], payload: &[u8]) -> Vec<u8> {
+    let g = u16::from_le_bytes([bytes[12], bytes[13]]) as usize;
+    let mut out = bytes[..14 + g].to_vec();
+    out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
+    out.extend_from_slice(&crc32(payload).to_le_bytes());
+    out.extend_from_slice(payload);
+    out
+}
+
+/// CRC-32 (IEEE, reflected), bit by bit: an independent check of the FMU's.
+fn crc32(data: &[u8]) -> u32 {
+    let mut crc = !0u32;
+    for &b in data {
+        crc ^= b as u32;
+        for _ in 0..8 {
+            crc = if crc & 1 != 0 {
+                (crc >> 1) ^ 0xedb8_8320
+            } else {
+                crc >> 1
+            };
+        }
+    }
+    !crc
+}
+
+#[test]
+fn corrupt_foreign_and_fuzzed_states_are_refused_and_never_crash() {
+    let fmu = Fmu::new();
+    fmu.init();
+    fmu.run(0.0, 0.25, 3);
+    let mut saved: ffi::fmi2FMUstate = ptr::null_mut();
+    assert_eq!(fmu.get_state(&mut saved), OK);
+    let bytes = fmu.serialize(saved);
+    let g = u16::from_le_bytes([bytes[12], bytes[13]]) as usize;
+    let payload = bytes[14 + g + 12..].to_vec();
+    assert_eq!(
+        seal(&bytes, &payload),
+        bytes,
+        "the test's CRC matches the FMU's"
+    );
+    let try_load = |candidate: &[u8]| -> ffi::fmi2Status {
+        let target = Fmu::new();
+        let mut s: ffi::fmi2FMUstate = ptr::null_mut();
+        let status = target.deserialize(candidate, &mut s);
+        if status == OK {
+            // A payload that decodes must still restore or be refused.
+            let restored = target.set_state(s);
+            assert!(restored == OK || restored == ERROR);
+            assert_eq!(target.free_state(&mut s), OK);
+            restored
+        } else {
+            assert!(s.is_null());
+            assert!(!target.log.lines().is_empty(), "a refusal says why");
+            status
+        }
+    };
+    // Every truncation and every single-bit flip of the header or payload.
+    for n in 0..bytes.len() {
+        assert_eq!(try_load(&bytes[..n]), ERROR, "truncated to {n}");
+    }
+    for i in 0..bytes.len() {
+        for bit in [0, 3, 7] {
+            let mut bad = bytes.clone();
+            bad[i] ^= 1 << bit;
+            assert_eq!(try_load(&bad), ERROR, "byte {i} bit {bit}");
+        }
+    }
+    // Another FMU (another GUID) and another format version.
+    let mut foreign = bytes.clone();
+    foreign[14] ^= 0x01;
+    let target = Fmu::new();
+    let mut s: ffi::fmi2FMUstate = ptr::null_mut();
+    assert_eq!(target.deserialize(&foreign, &mut s), ERROR);
+    assert!(target.log.contains(&["saved by the FMU with GUID"]));
+    let mut version = bytes.clone();
+    version[8] = 9;
+    assert_eq!(target.deserialize(&version, &mut s), ERROR);
+    assert!(target.log.contains(&["format version 9"]));
+    // Bounded fuzz: random payloads under a valid header (past the
+    // checksum) and random mutations of the valid one.
+    let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+    for _ in 0..3000 {
+        let mut p = payload.clone();
+        match rng.next() % 3 {
+            0 => {
+                let len = (rng.next() % 200) as usize;
+                p = (0..len).map(|_| rng.next() as u8).collect();
+            }
+            1 => {
+                for _ in 0..1 + rng.next() % 4 {
+                    let i = (rng.next() as usize) % p.len();
+                    p[i] = rng.next() as u8;
+                }
+            }
+            _ => {
+                let cut = (rng.next() as usize) % p.len();
+                p.truncate(cut);
+            }
+        }
+        let status = try_load(&seal(&bytes, &p));
+        assert!(status == OK || status == ERROR);
+    }
+    // Random bytes without any header.
+    for _ in 0..500 {
+        let len = (rng.next() % 300) as usize;
+        let junk: Vec<u8> = (0..len).map(|_| rng.next() as u8).collect();
+        assert_eq!(try_load(&junk), ERROR);
+    }
+    assert_eq!(fmu.free_state(&mut saved), OK);
 }

@@ -664,3 +664,83 @@ fn reset_then_the_same_run_equals_a_fresh_instance() {
     assert_eq!(first, again, "after fmi2Reset");
     assert_eq!(first, new, "a fresh instance");
 }
+
+impl Fmu {
+    /// `n` steps of `h` with a torque that changes every step (the FSAL
+    /// stage is dropped then) or holds (kept): the outputs as bits.
+    fn drive(&mut self, n: usize, h: f64) -> Vec<[u64; 5]> {
+        let tau = [vref("tau[1]"), vref("tau[2]")];
+        (0..n)
+            .map(|k| {
+                let level = if k % 3 == 0 {
+                    0.1 * (k as f64).sin()
+                } else {
+                    0.0
+                };
+                assert_eq!(self.set(&tau, &[level, -0.5 * level]), OK);
+                self.step(h);
+                self.outputs().map(f64::to_bits)
+            })
+            .collect()
+    }
+
+    fn serialized_state(&self) -> Vec<u8> {
+        let mut s: ffi::fmi2FMUstate = ptr::null_mut();
+        let mut size = 0;
+        unsafe {
+            assert_eq!(fmi2GetFMUstate(self.c, &mut s), OK);
+            assert_eq!(fmi2SerializedFMUstateSize(self.c, s, &mut size), OK);
+            let mut bytes = vec![0u8; size];
+            assert_eq!(
+                fmi2SerializeFMUstate(self.c, s, bytes.as_mut_ptr() as *mut _, size),
+                OK
+            );
+            assert_eq!(fmi2FreeFMUstate(self.c, &mut s), OK);
+            bytes
+        }
+    }
+
+    fn load_state(&mut self, bytes: &[u8], t: f64) {
+        let mut s: ffi::fmi2FMUstate = ptr::null_mut();
+        unsafe {
+            assert_eq!(
+                fmi2DeSerializeFMUstate(self.c, bytes.as_ptr() as *const _, bytes.len(), &mut s),
+                OK
+            );
+            assert_eq!(
+                fmi2SetFMUstate(self.c, s),
+                OK,
+                "{:?}",
+                self.instance.log.lines()
+            );
+            assert_eq!(fmi2FreeFMUstate(self.c, &mut s), OK);
+        }
+        self.t = t;
+    }
+}
+
+#[test]
+fn a_saved_plant_continues_bit_for_bit_here_and_in_a_fresh_instance() {
+    let h = 0.025;
+    let mut fmu = Fmu::start(&swing());
+    fmu.drive(37, h);
+    let (bytes, t) = (fmu.serialized_state(), fmu.t);
+    let reference = fmu.drive(80, h);
+    fmu.load_state(&bytes, t);
+    assert_eq!(fmu.drive(80, h), reference, "same instance");
+    let mut fresh = Fmu::instantiate();
+    fresh.load_state(&bytes, t);
+    assert_eq!(fresh.drive(80, h), reference, "fresh instance");
+    // A state from before initialization: the parameters come back too.
+    let early = Fmu::instantiate();
+    assert_eq!(early.set(&[vref("q0[1]")], &[0.3]), OK);
+    let before = early.serialized_state();
+    let mut other = Fmu::instantiate();
+    other.load_state(&before, 0.0);
+    unsafe {
+        assert_eq!(fmi2SetupExperiment(other.c, 0, 0.0, 0.0, 0, 0.0), OK);
+        assert_eq!(fmi2EnterInitializationMode(other.c), OK);
+        assert_eq!(fmi2ExitInitializationMode(other.c), OK);
+    }
+    assert_eq!(other.outputs()[0], 0.3);
+}

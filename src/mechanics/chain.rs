@@ -24,7 +24,7 @@ use super::{DynamicsJacobian, Matrix, MechanicalSystem, Vector};
 use thiserror::Error;
 
 /// One rigid link.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Link {
     /// Mass `m` (kg).
     pub mass: f64,
@@ -67,7 +67,7 @@ impl Link {
 }
 
 /// One actuated joint: motor, friction and an optional spring.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Joint {
     /// Rotor inertia of the joint's motor before the gearbox, `Ir` (kg m^2).
     pub rotor_inertia: f64,
@@ -98,11 +98,13 @@ impl Default for Joint {
 }
 
 /// Physical parameters of a [`PlanarChain`].
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PlanarChainParams<const N: usize> {
     /// Links, from the base outwards.
+    #[serde(with = "serde_big_array::BigArray")]
     pub links: [Link; N],
     /// Joints; joint `j` drives link `j` and its motor sits on link `j - 1`.
+    #[serde(with = "serde_big_array::BigArray")]
     pub joints: [Joint; N],
     /// Gravitational acceleration `g` (m/s^2).
     pub gravity: f64,
@@ -168,7 +170,7 @@ pub enum ParamsError {
 }
 
 /// A planar serial chain of rigid links with geared motors and joint friction.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PlanarChain<const N: usize> {
     params: PlanarChainParams<N>,
     /// `A_jl`, the amplitudes of the absolute link inertia `A_jl cos(phi_j - phi_l)`.

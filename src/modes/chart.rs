@@ -8,7 +8,7 @@ use crate::mechanics::Vector;
 use nalgebra::{DMatrix, DVector};
 
 /// A polynomial chart `X(s)` of an eigenmode (paper, definition 4).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Chart<const N: usize> {
     /// Polynomial degree (the paper uses 9).
     pub degree: usize,
@@ -17,6 +17,7 @@ pub struct Chart<const N: usize> {
     /// Equilibrium `q_eq` the coordinate is measured from.
     pub equilibrium: Vector<N>,
     /// Per joint `j`, coefficients of `s^k`, `k = 0..=degree`.
+    #[serde(with = "serde_big_array::BigArray")]
     pub coefficients: [Vec<f64>; N],
     /// Largest `|X_j(s_i) - q_ij|` over the fitted samples (rad).
     pub max_residual: f64,

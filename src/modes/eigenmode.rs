@@ -37,7 +37,7 @@ pub struct Eigenmode<const N: usize> {
 }
 
 /// Settings of the shooting and the energy continuation.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ContinuationOptions {
     /// Path samples per orbit, turning point to turning point inclusive.
     pub samples: usize,

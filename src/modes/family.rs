@@ -12,7 +12,7 @@ use super::{Chart, ContinuationOptions, ModeError, continue_family, linear_modes
 use crate::mechanics::{MechanicalSystem, Vector};
 
 /// How a [`ChartFamily`] is computed.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct FamilyOptions {
     /// Lowest grid energy (J), > 0.
     pub energy_min: f64,
@@ -102,7 +102,7 @@ impl FamilyOptions {
 }
 
 /// Charts of one eigenmode family on an energy grid (the eigenmanifold).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ChartFamily<const N: usize> {
     mode_index: usize,
     degree: usize,

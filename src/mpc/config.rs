@@ -204,4 +204,7 @@ pub enum MpcError {
     /// The eigenvector or chart is unusable.
     #[error("invalid reference: {0}")]
     InvalidReference(String),
+    /// A saved state does not fit this controller ([`super::Controller::restore_state`]).
+    #[error("saved state does not fit: {0}")]
+    InvalidState(String),
 }

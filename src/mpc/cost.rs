@@ -8,7 +8,7 @@ use crate::modes::Chart;
 use nalgebra::{SMatrix, SVector};
 
 /// The paper's weights `W_z = diag(w_E, w_x, w_x, w_xd, w_xd)`, `W_F = w_F I`.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Weights {
     /// Energy error weight `w_E`.
     pub energy: f64,
@@ -34,7 +34,7 @@ impl Weights {
 }
 
 /// The a-priori knowledge the cost measures distances to.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Reference<const N: usize> {
     /// Straight EigenMPC: the unit linear eigenvector `c`.
     Straight {
@@ -107,7 +107,7 @@ impl<const N: usize> Reference<N> {
 }
 
 /// Tunable cost parameters (may change between samples).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CostParams {
     /// Reference energy `E_ref` (J).
     pub e_ref: f64,

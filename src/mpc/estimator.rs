@@ -45,7 +45,7 @@ impl EstimatorConfig {
 }
 
 /// The extended Kalman filter of a controller (`NX = 2 N`).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct Ekf<const N: usize, const NX: usize> {
     estimate: SVector<f64, NX>,
     covariance: SMatrix<f64, NX, NX>,

@@ -21,6 +21,7 @@ pub mod cost;
 mod estimator;
 mod linearise;
 pub mod prediction;
+mod saved;
 mod sqp;
 mod status;
 mod variant;
@@ -29,6 +30,7 @@ pub use config::{MAX_HORIZON, MpcConfig, MpcError, SqpOptions};
 pub use cost::{CostParams, Reference, Weights};
 pub use estimator::EstimatorConfig;
 pub use prediction::{prediction_coulomb_sharpness, prediction_substeps};
+pub use saved::ControllerState;
 pub use status::{ControlOutput, ControlStatus};
 pub use variant::{VARIANTS, Variant, VariantInfo};
 

@@ -249,4 +249,23 @@ pub trait QpSolver {
     fn shift_warm_start(&mut self, previous_usable: bool) {
         let _ = previous_usable;
     }
+    /// What a later solve reads of the earlier ones (the warm start), for a
+    /// saved controller state ([`crate::mpc::Controller::save_state`]).
+    /// Default: nothing (a solver without memory between solves).
+    fn save_warm_start(&self) -> Vec<f64> {
+        Vec::new()
+    }
+    /// Restores [`QpSolver::save_warm_start`] of a solver of the same kind
+    /// and dimensions; an error if `saved` does not fit.
+    fn restore_warm_start(&mut self, saved: &[f64]) -> Result<(), String> {
+        if saved.is_empty() {
+            Ok(())
+        } else {
+            Err(format!(
+                "the {} solver keeps no warm start, {} values given",
+                self.name(),
+                saved.len()
+            ))
+        }
+    }
 }

@@ -3,10 +3,11 @@
 //! the same way.
 
 use super::settings::{ChainController, Settings};
-use eigenmpc::adapt::Adaptation;
+use eigenmpc::adapt::{Adaptation, AdaptationState};
 use eigenmpc::identify::BaseParameters;
+use eigenmpc::mechanics::PlanarChain;
 use eigenmpc::mechanics::Vector;
-use eigenmpc::mpc::ControlOutput;
+use eigenmpc::mpc::{ControlOutput, ControllerState};
 use nalgebra::SVector;
 
 /// An `N`-joint controller (`NX = 2 N`, `NP` =
@@ -95,8 +96,40 @@ impl<const N: usize, const NX: usize, const NP: usize> AdaptiveController<N, NX,
         }
     }
 
+    /// Everything the next samples depend on (an FMU's saved state).
+    pub fn save_state(&self) -> AdaptiveState<N, NX, NP> {
+        AdaptiveState {
+            controller: self.controller.save_state(),
+            adaptation: self.adaptation.as_ref().map(|a| a.save_state()),
+            tau: self.tau,
+        }
+    }
+
+    /// Continues from `state`, saved by a controller built from the same
+    /// settings.
+    pub fn restore_state(&mut self, state: AdaptiveState<N, NX, NP>) -> Result<(), String> {
+        match (&mut self.adaptation, state.adaptation) {
+            (Some(a), Some(saved)) => a.restore_state(saved).map_err(|e| e.to_string())?,
+            (None, None) => {}
+            _ => return Err("the saved state has another adapt setting".into()),
+        }
+        self.controller
+            .restore_state(state.controller)
+            .map_err(|e| e.to_string())?;
+        self.tau = state.tau;
+        Ok(())
+    }
+
     /// Models taken from the identification so far (0 without `adapt`).
     pub fn model_updates(&self) -> usize {
         self.adaptation.as_ref().map_or(0, |a| a.model_updates())
     }
+}
+
+/// The state of an [`AdaptiveController`] between two samples.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct AdaptiveState<const N: usize, const NX: usize, const NP: usize> {
+    controller: ControllerState<PlanarChain<N>, N, NX>,
+    adaptation: Option<AdaptationState<N, NP>>,
+    tau: Vector<N>,
 }

@@ -128,6 +128,18 @@ pub struct ControllerFmu<P, const N: usize, const NX: usize, const NP: usize> {
     product: PhantomData<fn() -> P>,
 }
 
+/// What [`ControllerFmu`] saves as its FMU state (the settings and the
+/// table follow from the values).
+#[derive(serde::Serialize, serde::Deserialize)]
+struct SavedController<const N: usize, const NX: usize, const NP: usize> {
+    controller: adaptive::AdaptiveState<N, NX, NP>,
+    solved_at: f64,
+    updates_reported: usize,
+    failed_solves: usize,
+    clock: SampleClock,
+    solved_state: SVector<f64, NX>,
+}
+
 /// The model description of product `P`.
 pub fn description<P: ControllerProduct<N>, const N: usize>() -> ModelDescription {
     let t = table::table::<N>();
@@ -140,6 +152,7 @@ pub fn description<P: ControllerProduct<N>, const N: usize>() -> ModelDescriptio
         author: "EigenMPC project".into(),
         generation_tool: format!("fmi2-slave (EigenMPC) {}", env!("CARGO_PKG_VERSION")),
         can_handle_variable_communication_step_size: true,
+        can_save_state: true,
         default_experiment: Some(DefaultExperiment {
             start_time: 0.0,
             stop_time: 30.0,
@@ -214,6 +227,44 @@ impl<P: ControllerProduct<N> + Send, const N: usize, const NX: usize, const NP: 
             }
             Tick::AtStart | Tick::Hold => {}
         }
+        Ok(())
+    }
+
+    fn save_state(&self) -> Result<Vec<u8>, ModelError> {
+        fmi2_slave::state::encode_model(&SavedController {
+            controller: self.controller.save_state(),
+            solved_at: self.solved_at,
+            updates_reported: self.updates_reported,
+            failed_solves: self.failed_solves,
+            clock: self.clock.clone(),
+            solved_state: self.solved_state,
+        })
+    }
+
+    fn restore_state(
+        &mut self,
+        state: &[u8],
+        values: &Values,
+        _ctx: &Context,
+    ) -> Result<(), ModelError> {
+        let saved: SavedController<N, NX, NP> = fmi2_slave::state::decode_model(state)?;
+        if !(saved.solved_at.is_finite() && saved.solved_state.iter().all(|v| v.is_finite())) {
+            return Err(ModelError::Error(
+                "malformed controller state: non-finite time or state".into(),
+            ));
+        }
+        // The tuning the controller was last given is in the values.
+        let mut settings = self.settings.clone();
+        self.table.read(values, &mut settings, |r| r.is_tunable());
+        self.controller
+            .restore_state(saved.controller)
+            .map_err(|e| ModelError::Error(format!("malformed controller state: {e}")))?;
+        self.settings = settings;
+        self.solved_at = saved.solved_at;
+        self.updates_reported = saved.updates_reported;
+        self.failed_solves = saved.failed_solves;
+        self.clock = saved.clock;
+        self.solved_state = saved.solved_state;
         Ok(())
     }
 

@@ -24,7 +24,7 @@ pub enum Tick {
 }
 
 /// The sample grid and its warnings.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SampleClock {
     sample_period: f64,
     start_time: f64,

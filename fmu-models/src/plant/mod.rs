@@ -77,6 +77,7 @@ pub fn description<P: PlantProduct<N>, const N: usize>() -> ModelDescription {
         author: "EigenMPC project".into(),
         generation_tool: format!("fmi2-slave (EigenMPC) {}", env!("CARGO_PKG_VERSION")),
         can_handle_variable_communication_step_size: true,
+        can_save_state: true,
         default_experiment: Some(DefaultExperiment {
             start_time: 0.0,
             stop_time: 10.0,
@@ -132,6 +133,31 @@ impl<P: PlantProduct<N>, const N: usize, const NX: usize> Model for PlantFmu<P, 
         };
         model.write_outputs(values);
         Ok(model)
+    }
+
+    fn save_state(&self) -> Result<Vec<u8>, ModelError> {
+        fmi2_slave::state::encode_model(&(&self.ode, &self.tau))
+    }
+
+    fn restore_state(
+        &mut self,
+        state: &[u8],
+        _values: &Values,
+        _ctx: &Context,
+    ) -> Result<(), ModelError> {
+        // The model was built from the same parameters: only the
+        // integrator (time, state, step size, FSAL stage, counters) and
+        // the torque of its cached stage move.
+        let (ode, tau): (Dopri5<SVector<f64, NX>>, Vector<N>) =
+            fmi2_slave::state::decode_model(state)?;
+        if !(ode.time().is_finite() && ode.state().iter().all(|v| v.is_finite())) {
+            return Err(ModelError::Error(
+                "malformed plant state: non-finite time or state".into(),
+            ));
+        }
+        self.ode = ode;
+        self.tau = tau;
+        Ok(())
     }
 
     fn do_step(

@@ -239,6 +239,28 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
         }
     }
 
+    /// The multipliers a warm start reads (`pi`, `lam` per stage), appended to `out`.
+    pub(super) fn save_multipliers(&self, out: &mut Vec<f64>) {
+        for st in &self.st {
+            out.extend_from_slice(st.pi.as_slice());
+            out.extend_from_slice(&st.lam);
+        }
+    }
+
+    /// Restores what [`FixedCore::save_multipliers`] wrote; false if the
+    /// length does not fit this core.
+    pub(super) fn restore_multipliers(&mut self, data: &[f64]) -> bool {
+        let per = NX + M;
+        if data.len() != per * self.st.len() {
+            return false;
+        }
+        for (st, d) in self.st.iter_mut().zip(data.chunks_exact(per)) {
+            st.pi.as_mut_slice().copy_from_slice(&d[..NX]);
+            st.lam.copy_from_slice(&d[NX..]);
+        }
+        true
+    }
+
     /// Copies the (validated) QP into the stage blocks and marks the
     /// existing inequalities.
     pub(super) fn load(&mut self, qp: &OcpQp, set: &RiccatiSettings) {

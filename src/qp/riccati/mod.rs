@@ -371,6 +371,64 @@ impl QpSolver for RiccatiSolver {
         "riccati"
     }
 
+    fn save_warm_start(&self) -> Vec<f64> {
+        let mut out = vec![
+            f64::from(u8::from(self.warm_next)),
+            self.total_regularised as f64,
+        ];
+        match &self.engine {
+            Engine::Runtime(ws) => {
+                out.extend_from_slice(&ws.pi);
+                out.extend_from_slice(&ws.lam);
+            }
+            Engine::Joints1(core) => core.save_multipliers(&mut out),
+            Engine::Joints2(core) => core.save_multipliers(&mut out),
+            Engine::Joints3(core) => core.save_multipliers(&mut out),
+        }
+        out
+    }
+
+    fn restore_warm_start(&mut self, saved: &[f64]) -> Result<(), String> {
+        let fits = match saved {
+            [warm, regularised, data @ ..]
+                if (*warm == 0.0 || *warm == 1.0) && *regularised >= 0.0 =>
+            {
+                let ok = match &mut self.engine {
+                    Engine::Runtime(ws) => {
+                        let (np, nl) = (ws.pi.len(), ws.lam.len());
+                        if data.len() == np + nl {
+                            ws.pi.copy_from_slice(&data[..np]);
+                            ws.lam.copy_from_slice(&data[np..]);
+                            true
+                        } else {
+                            false
+                        }
+                    }
+                    Engine::Joints1(core) => core.restore_multipliers(data),
+                    Engine::Joints2(core) => core.restore_multipliers(data),
+                    Engine::Joints3(core) => core.restore_multipliers(data),
+                };
+                if ok {
+                    self.warm_next = *warm == 1.0;
+                    self.total_regularised = *regularised as u64;
+                }
+                ok
+            }
+            _ => false,
+        };
+        if fits {
+            Ok(())
+        } else {
+            Err(format!(
+                "{} warm-start values do not fit the riccati solver for nx = {}, nu = {}, N = {}",
+                saved.len(),
+                self.nx,
+                self.nu,
+                self.horizon
+            ))
+        }
+    }
+
     fn shift_warm_start(&mut self, previous_usable: bool) {
         let floor = self.settings.warm_start_floor;
         // A floor that is not positive would start on the boundary.
