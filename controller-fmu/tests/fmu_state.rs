@@ -64,7 +64,7 @@ impl Loop {
         TestInstance::new::<EigenMpcFmu>(Some(fmi2Instantiate), "controller")
     }
 
-    fn start() -> Self {
+    fn start(qp_solver: i32) -> Self {
         let fmu = Self::instantiate();
         let c = fmu.component;
         let z0 = [0.05, 0.05, 0.0, 0.0];
@@ -73,6 +73,7 @@ impl Loop {
             assert_eq!(fmi2SetBoolean(c, &vref("adapt"), 1, &on), OK);
             let ekf = STATE_ESTIMATOR_EKF;
             assert_eq!(fmi2SetInteger(c, &vref("state_estimator"), 1, &ekf), OK);
+            assert_eq!(fmi2SetInteger(c, &vref("qp_solver"), 1, &qp_solver), OK);
             assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), OK);
             assert_eq!(fmi2EnterInitializationMode(c), OK);
             assert_eq!(fmi2SetReal(c, state_vrs().as_ptr(), 4, z0.as_ptr()), OK);
@@ -149,7 +150,15 @@ fn serialize(c: ffi::fmi2Component, s: ffi::fmi2FMUstate) -> Vec<u8> {
 
 #[test]
 fn a_saved_controller_continues_bit_for_bit_here_elsewhere_and_from_bytes() {
-    let mut first = Loop::start();
+    // Both QP backends: riccati's warm start is part of the state; clarabel
+    // keeps none between solves.
+    for qp_solver in [QP_SOLVER_RICCATI, QP_SOLVER_CLARABEL] {
+        continues_bit_for_bit(qp_solver);
+    }
+}
+
+fn continues_bit_for_bit(qp_solver: i32) {
+    let mut first = Loop::start(qp_solver);
     // 1.5 s: between two looks of the adaptation (adapt_period 1 s), with
     // a request in flight.
     first.run(60);
@@ -204,7 +213,7 @@ fn a_saved_controller_continues_bit_for_bit_here_elsewhere_and_from_bytes() {
 
 #[test]
 fn a_state_of_another_set_up_or_fmu_is_refused() {
-    let mut running = Loop::start();
+    let mut running = Loop::start(QP_SOLVER_RICCATI);
     running.run(4);
     let saved = running.save();
     let bytes = serialize(running.fmu.component, saved);

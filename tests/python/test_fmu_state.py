@@ -34,18 +34,20 @@ def start_pair(controller_md, controller_dir, plant_md, plant_dir):
     return ctrl, plant
 
 
-def run(ctrl, plant, steps):
+def run(ctrl, plant, steps, joints=2, outputs=OUTPUTS):
     """Gauss-Seidel loop; one row of outputs (as float64) per step."""
+    state = [f"q[{j}]" for j in range(1, joints + 1)] + [f"qd[{j}]" for j in range(1, joints + 1)]
+    tau_names = [f"tau[{j}]" for j in range(1, joints + 1)]
     rows = []
     for _ in range(steps):
-        z = plant.fmu.getReal([plant.vr[n] for n in STATE])
-        ctrl.fmu.setReal([ctrl.vr[n] for n in STATE], z)
+        z = plant.fmu.getReal([plant.vr[n] for n in state])
+        ctrl.fmu.setReal([ctrl.vr[n] for n in state], z)
         ctrl.step(DT)
-        tau = ctrl.get("tau[1]", "tau[2]")
-        plant.fmu.setReal([plant.vr["tau[1]"], plant.vr["tau[2]"]], tau)
+        tau = ctrl.get(*tau_names)
+        plant.fmu.setReal([plant.vr[n] for n in tau_names], tau)
         plant.step(DT)
         (updates,) = ctrl.fmu.getInteger([ctrl.vr["model_updates"]])
-        rows.append([*ctrl.get(*OUTPUTS), *plant.get("energy", *STATE), updates])
+        rows.append([*ctrl.get(*outputs), *plant.get("energy", *state), updates])
     return np.array(rows)
 
 
@@ -108,6 +110,29 @@ def test_a_saved_closed_loop_continues_bit_for_bit(
         slave.fmu.freeFMUstate(state)
     ctrl.free()
     plant.free()
+
+
+def test_three_links_continue_bit_for_bit(three_link_pair):
+    (cmd, cdir), (pmd, pdir) = three_link_pair
+    ctrl, plant = Slave(cmd, cdir, "controller3"), Slave(pmd, pdir, "chain")
+    plant.initialize({f"q0[{j}]": 0.05 for j in (1, 2, 3)})
+    ctrl.initialize({f"q[{j}]": 0.05 for j in (1, 2, 3)})
+    outputs = ["tau[1]", "tau[2]", "tau[3]", "energy"]
+    run(ctrl, plant, 40, joints=3, outputs=outputs)
+    saved = (ctrl.fmu.getFMUstate(), plant.fmu.getFMUstate())
+    times = (ctrl.time, plant.time)
+    reference = run(ctrl, plant, 80, joints=3, outputs=outputs)
+    blobs = [ctrl.fmu.serializeFMUstate(saved[0]), plant.fmu.serializeFMUstate(saved[1])]
+    ctrl2, plant2 = Slave(cmd, cdir, "controller3-restored"), Slave(pmd, pdir, "chain-restored")
+    for slave, blob, t in ((ctrl2, blobs[0], times[0]), (plant2, blobs[1], times[1])):
+        state = slave.fmu.deSerializeFMUstate(blob)
+        slave.fmu.setFMUstate(state)
+        slave.fmu.freeFMUstate(state)
+        slave.time = t
+    again = run(ctrl2, plant2, 80, joints=3, outputs=outputs)
+    assert np.array_equal(again.view(np.uint64), reference.view(np.uint64))
+    for slave in (ctrl, plant, ctrl2, plant2):
+        slave.free()
 
 
 def test_bad_state_buffers_are_errors_with_a_reason(controller_md, controller_unzipped, plant_md, plant_unzipped):
