@@ -76,6 +76,16 @@ if [ ! -e "$libcosim_stamp" ]; then
         echo "warning: libcosimpy did not install; the libcosim test will be skipped" >&2
     fi
 fi
+# ecos (ecospy) runs the shipped SSP; its wheel needs Debian's oneTBB runtime.
+dpkg -s libtbb12 >/dev/null 2>&1 || apt_install libtbb12
+ecos_stamp=.venv/.ecospy.ok
+if [ ! -e "$ecos_stamp" ]; then
+    if .venv/bin/pip install -q --disable-pip-version-check ecospy; then
+        touch "$ecos_stamp"
+    else
+        echo "warning: ecospy did not install; the ecos SSP test will be skipped" >&2
+    fi
+fi
 echo "== release CLI (the Python tests compare with \`eigenmpc simulate\`)"
 cargo build --release --bin eigenmpc
 echo "== pytest"

@@ -6,13 +6,17 @@
 //! `modelDescription/`), zips `target/fmu/<modelIdentifier>.fmu`
 //! (`modelDescription.xml`, `binaries/linux64/<modelIdentifier>.so`,
 //! `documentation/index.html`; the binary stripped of debug information,
-//! which is kept apart in `target/fmu/<modelIdentifier>.so.debug`), generates `include/eigenmpc.h` (the plain C
+//! which is kept apart in `target/fmu/<modelIdentifier>.so.debug`), the
+//! closed loops as SSP archives (`target/fmu/EigenMPC-DoublePendulum.ssp`,
+//! [`ssp`]), generates `include/eigenmpc.h` (the plain C
 //! API with cbindgen, config `cbindgen.toml`, and every FMU's value-reference
 //! and enumeration constants from its variable table) next to the standard
 //! FMI 2.0 headers, and rewrites the README's FMU variable tables from the
 //! variable tables.
 //!
 //! Adding an FMU is one entry in [`FMUS`].
+
+mod ssp;
 
 use anyhow::{Context, Result, bail};
 use std::io::Write;
@@ -337,6 +341,10 @@ fn main() -> Result<()> {
             );
         }
         let path = package(&ws, fmu, &xml, &html)?;
+        println!("wrote {}", path.display());
+    }
+    for spec in ssp::SSPS {
+        let path = ssp::package(&ws.target.join("fmu"), spec)?;
         println!("wrote {}", path.display());
     }
     let h = header(&ws)?;

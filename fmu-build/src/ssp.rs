@@ -1,0 +1,190 @@
+//! The closed loops as SSP 1.0 archives (`target/fmu/<name>.ssp`): the
+//! controller FMU and the plant FMU with their connections (plant state to
+//! controller inputs, controller torques to plant inputs) and the start
+//! state, so that an SSP importer (fmpy's `simulate_ssp`, ecos, OMSimulator)
+//! runs the paper's 14 J scenario from one file.
+
+use anyhow::Result;
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+use zip::write::SimpleFileOptions;
+
+/// One closed loop shipped as an SSP.
+pub struct SspSpec {
+    /// Archive name (`<name>.ssp`).
+    pub name: &'static str,
+    /// The controller FMU's `modelIdentifier`.
+    pub controller: &'static str,
+    /// The plant FMU's `modelIdentifier`.
+    pub plant: &'static str,
+    /// Joints of the chain.
+    pub joints: usize,
+}
+
+/// The closed loops this workspace ships.
+pub const SSPS: &[SspSpec] = &[
+    SspSpec {
+        name: "EigenMPC-DoublePendulum",
+        controller: "EigenMPC",
+        plant: "DoublePendulum",
+        joints: 2,
+    },
+    SspSpec {
+        name: "EigenMPC3-TriplePendulum",
+        controller: "EigenMPC3",
+        plant: "TriplePendulum",
+        joints: 3,
+    },
+];
+
+/// Start angle of every joint (rad), at rest: the paper's scenario start.
+pub const START_ANGLE: f64 = 0.05;
+/// Name of the parameter set with the start state (ecos: `init(parameter_set=...)`).
+pub const PARAMETER_SET: &str = "initialValues";
+/// Stop time of the default experiment (s).
+pub const STOP_TIME: f64 = 30.0;
+
+fn connector(out: &mut String, name: &str, kind: &str) {
+    writeln!(
+        out,
+        r#"          <ssd:Connector name="{name}" kind="{kind}"><ssc:Real/></ssd:Connector>"#
+    )
+    .unwrap();
+}
+
+fn parameter_bindings(out: &mut String, values: &[(String, f64)]) {
+    out.push_str("        <ssd:ParameterBindings>\n          <ssd:ParameterBinding>\n");
+    out.push_str("            <ssd:ParameterValues>\n");
+    writeln!(
+        out,
+        r#"              <ssv:ParameterSet version="1.0" name="{PARAMETER_SET}">"#
+    )
+    .unwrap();
+    out.push_str("                <ssv:Parameters>\n");
+    for (name, value) in values {
+        writeln!(
+            out,
+            r#"                  <ssv:Parameter name="{name}"><ssv:Real value="{value}"/></ssv:Parameter>"#
+        )
+        .unwrap();
+    }
+    out.push_str("                </ssv:Parameters>\n              </ssv:ParameterSet>\n");
+    out.push_str("            </ssd:ParameterValues>\n          </ssd:ParameterBinding>\n");
+    out.push_str("        </ssd:ParameterBindings>\n");
+}
+
+/// `SystemStructure.ssd` of `spec`.
+pub fn system_structure(spec: &SspSpec) -> String {
+    let joints: Vec<usize> = (1..=spec.joints).collect();
+    let state: Vec<String> = joints
+        .iter()
+        .map(|j| format!("q[{j}]"))
+        .chain(joints.iter().map(|j| format!("qd[{j}]")))
+        .collect();
+    let torques: Vec<String> = joints.iter().map(|j| format!("tau[{j}]")).collect();
+    let mut s = String::new();
+    s.push_str(r#"<?xml version="1.0" encoding="UTF-8"?>"#);
+    s.push('\n');
+    writeln!(
+        s,
+        r#"<ssd:SystemStructureDescription xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon" xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription" xmlns:ssv="http://ssp-standard.org/SSP1/SystemStructureParameterValues" version="1.0" name="{}" generationTool="fmu-build (EigenMPC) {}">"#,
+        spec.name,
+        env!("CARGO_PKG_VERSION")
+    )
+    .unwrap();
+    writeln!(
+        s,
+        r#"  <ssd:System name="loop" description="{} drives {}: the {}-link chain's state to the controller, its torques to the chain, from q = {START_ANGLE} rad at rest; communication step 25 ms (the controller's sample period)">"#,
+        spec.controller, spec.plant, spec.joints
+    )
+    .unwrap();
+    s.push_str("    <ssd:Elements>\n");
+    // The controller: the chain's state in, torques and energy out; its
+    // start inputs equal the plant's start state (the first solve uses them).
+    writeln!(
+        s,
+        r#"      <ssd:Component name="controller" type="application/x-fmu-sharedlibrary" source="resources/{}.fmu">"#,
+        spec.controller
+    )
+    .unwrap();
+    s.push_str("        <ssd:Connectors>\n");
+    for n in &state {
+        connector(&mut s, n, "input");
+    }
+    for n in &torques {
+        connector(&mut s, n, "output");
+    }
+    connector(&mut s, "energy", "output");
+    s.push_str("        </ssd:Connectors>\n");
+    parameter_bindings(
+        &mut s,
+        &joints
+            .iter()
+            .map(|j| (format!("q[{j}]"), START_ANGLE))
+            .collect::<Vec<_>>(),
+    );
+    s.push_str("      </ssd:Component>\n");
+    writeln!(
+        s,
+        r#"      <ssd:Component name="plant" type="application/x-fmu-sharedlibrary" source="resources/{}.fmu">"#,
+        spec.plant
+    )
+    .unwrap();
+    s.push_str("        <ssd:Connectors>\n");
+    for n in &torques {
+        connector(&mut s, n, "input");
+    }
+    for n in &state {
+        connector(&mut s, n, "output");
+    }
+    connector(&mut s, "energy", "output");
+    s.push_str("        </ssd:Connectors>\n");
+    parameter_bindings(
+        &mut s,
+        &joints
+            .iter()
+            .map(|j| (format!("q0[{j}]"), START_ANGLE))
+            .collect::<Vec<_>>(),
+    );
+    s.push_str("      </ssd:Component>\n    </ssd:Elements>\n    <ssd:Connections>\n");
+    let connection = |s: &mut String, from: &str, to: &str, name: &str| {
+        writeln!(
+            s,
+            r#"      <ssd:Connection startElement="{from}" startConnector="{name}" endElement="{to}" endConnector="{name}"/>"#
+        )
+        .unwrap();
+    };
+    for n in &state {
+        connection(&mut s, "plant", "controller", n);
+    }
+    for n in &torques {
+        connection(&mut s, "controller", "plant", n);
+    }
+    s.push_str("    </ssd:Connections>\n  </ssd:System>\n");
+    writeln!(
+        s,
+        r#"  <ssd:DefaultExperiment startTime="0" stopTime="{STOP_TIME}"/>"#
+    )
+    .unwrap();
+    s.push_str("</ssd:SystemStructureDescription>\n");
+    s
+}
+
+/// Writes `<fmu_dir>/<name>.ssp` from the FMUs already packaged there.
+pub fn package(fmu_dir: &Path, spec: &SspSpec) -> Result<PathBuf> {
+    let path = fmu_dir.join(format!("{}.ssp", spec.name));
+    let mut zip = zip::ZipWriter::new(std::fs::File::create(&path)?);
+    let opts = SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
+    zip.start_file("SystemStructure.ssd", opts)?;
+    zip.write_all(system_structure(spec).as_bytes())?;
+    for fmu in [spec.controller, spec.plant] {
+        // Already compressed: stored as it is.
+        let stored =
+            SimpleFileOptions::default().compression_method(zip::CompressionMethod::Stored);
+        zip.start_file(format!("resources/{fmu}.fmu"), stored)?;
+        zip.write_all(&std::fs::read(fmu_dir.join(format!("{fmu}.fmu")))?)?;
+    }
+    zip.finish()?;
+    Ok(path)
+}
