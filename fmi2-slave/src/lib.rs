@@ -23,8 +23,18 @@
 //! rlib defining them, so this crate defines none: each FMU crate invokes
 //! [`export_fmi2!`] exactly once, and no FMU crate links another.
 
-/// The FMI 2.0 C types and constants (bindgen output of the standard headers).
-pub use fmi_sys::fmi2 as ffi;
+/// The FMI 2.0 C types and constants (bindgen output of the standard
+/// headers in `fmi-standard2/headers`, see `build.rs`).
+#[allow(
+    non_upper_case_globals,
+    non_camel_case_types,
+    non_snake_case,
+    missing_docs,
+    clippy::all
+)]
+pub mod ffi {
+    include!(concat!(env!("OUT_DIR"), "/fmi2_bindings.rs"));
+}
 
 pub mod abi;
 mod export;

@@ -20,7 +20,7 @@ mod ssp;
 
 use anyhow::{Context, Result, bail};
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::Command;
 use zip::write::SimpleFileOptions;
 
@@ -96,8 +96,6 @@ const PLATFORM: &str = "linux64";
 struct Workspace {
     root: PathBuf,
     target: PathBuf,
-    /// Directory of the fmi-sys package (ships the standard headers).
-    fmi_sys: PathBuf,
 }
 
 fn cargo() -> String {
@@ -124,23 +122,9 @@ fn workspace() -> Result<Workspace> {
                 .with_context(|| format!("no {key} in cargo metadata"))?,
         ))
     };
-    let fmi_sys = meta["packages"]
-        .as_array()
-        .into_iter()
-        .flatten()
-        .find(|p| p["name"] == "fmi-sys")
-        .and_then(|p| p["manifest_path"].as_str())
-        .map(|m| {
-            Path::new(m)
-                .parent()
-                .unwrap_or(Path::new("."))
-                .to_path_buf()
-        })
-        .context("fmi-sys not in the dependency graph")?;
     Ok(Workspace {
         root: path("workspace_root")?,
         target: path("target_directory")?,
-        fmi_sys,
     })
 }
 
@@ -262,10 +246,10 @@ fn header(ws: &Workspace) -> Result<PathBuf> {
         "fmi2TypesPlatform.h",
     ] {
         std::fs::copy(
-            ws.fmi_sys.join("fmi-standard2/headers").join(h),
+            ws.root.join("fmi2-slave/fmi-standard2/headers").join(h),
             include.join(h),
         )
-        .with_context(|| format!("copying {h} from fmi-sys"))?;
+        .with_context(|| format!("copying {h} from fmi2-slave/fmi-standard2/headers"))?;
     }
     let out = include.join("eigenmpc.h");
     let mut text = Vec::new();
