@@ -86,7 +86,16 @@ if [ ! -e "$ecos_stamp" ]; then
         echo "warning: ecospy did not install; the ecos SSP test will be skipped" >&2
     fi
 fi
+# The Dask sweep runner (python/, with dask[distributed]), installed editable.
+sweep_stamp=.venv/.eigenmpc-sweep.sha
+want=$(sha256sum python/pyproject.toml | cut -d' ' -f1)
+if [ "$(cat "$sweep_stamp" 2>/dev/null)" != "$want" ]; then
+    .venv/bin/pip install -q --disable-pip-version-check -e python
+    echo "$want" >"$sweep_stamp"
+fi
 echo "== release CLI (the Python tests compare with \`eigenmpc simulate\`)"
 cargo build --release --bin eigenmpc
 echo "== pytest"
 .venv/bin/python -m pytest tests/python -rs
+echo "== pytest python/ (the Dask sweep runner against the native sweep)"
+.venv/bin/python -m pytest python/tests -rs

@@ -588,6 +588,31 @@ impl<S> Table<S> {
         }
     }
 
+    /// `settings` with the parameters `(name, value)` of the FMU described
+    /// by `d` (this table's description) set, each checked as `fmi2SetReal`
+    /// / `fmi2SetInteger` / `fmi2SetBoolean` would check it: Integer and
+    /// enumeration parameters take integral values, Boolean ones 0 or 1.
+    /// Refused, naming the variable: an unknown name, a variable that is
+    /// not a parameter, a value out of range or not integral where it must be.
+    /// `settings` must hold the table's start values (the defaults).
+    pub fn settings_from_named(
+        &self,
+        d: &crate::ModelDescription,
+        mut settings: S,
+        values: &[(&str, f64)],
+    ) -> Result<S, String> {
+        let mut current = Values::new(d);
+        for &(name, x) in values {
+            let (v, value) = named_value(d, name, x)?;
+            let index = current
+                .index(v.var_type.base(), v.value_reference)
+                .ok_or_else(|| format!("{name}: no value slot"))?;
+            current.set_at(index, value);
+        }
+        self.read(&current, &mut settings, |_| true);
+        Ok(settings)
+    }
+
     /// `(name, value)` of every element of the parameter rows selected by
     /// `select`, read from `settings`, in table order.
     pub fn start_values(
@@ -887,6 +912,33 @@ fn value_text(v: Value) -> String {
 }
 
 pub use crate::variables::compact;
+
+/// The parameter `name` of the FMU described by `d` and `x` as its value,
+/// checked as `fmi2Set*` would check it.
+pub fn named_value<'d>(
+    d: &'d crate::ModelDescription,
+    name: &str,
+    x: f64,
+) -> Result<(&'d Variable, Value), String> {
+    let v = d
+        .variable(name)
+        .ok_or_else(|| format!("{name} is not a variable of {}", d.model_name))?;
+    if v.causality != crate::Causality::Parameter {
+        return Err(format!(
+            "{name} is not a parameter of {} (it is set or read while running)",
+            d.model_name
+        ));
+    }
+    let value = match v.var_type.base() {
+        BaseType::Real => Value::Real(x),
+        BaseType::Boolean if x == 0.0 || x == 1.0 => Value::Boolean(x == 1.0),
+        BaseType::Boolean => return Err(format!("{name} = {x} must be 0 or 1 (Boolean)")),
+        _ if x.fract() == 0.0 && x.abs() <= i32::MAX as f64 => Value::Integer(x as i32),
+        _ => return Err(format!("{name} = {x} must be an integer")),
+    };
+    v.check_value(value)?;
+    Ok((v, value))
+}
 
 #[cfg(test)]
 mod tests {

@@ -4,6 +4,7 @@
 mod modes;
 mod robustness;
 mod simulate;
+mod sweep;
 
 use clap::{Args, Parser, Subcommand};
 use eigenmpc::mechanics::{DoublePendulum, PlanarChainParams};
@@ -28,6 +29,9 @@ enum Command {
     /// Robustness report: the controller against plants and set-ups that differ from its model
     /// (each parameter, noise, motor lag, delay), without and with online adaptation.
     Robustness(Box<robustness::RobustnessArgs>),
+    /// Closed loops over a grid or a random sample of controller, plant and set-up parameters,
+    /// on all cores; CSV, JSON and a plot of one metric.
+    Sweep(Box<sweep::SweepArgs>),
 }
 
 /// The robot: a parameter file, or the paper's point-mass double pendulum
@@ -159,6 +163,7 @@ pub fn main() -> ExitCode {
         Command::Modes(args) => modes::run(&args),
         Command::Simulate(args) => simulate::run_simulate(&args),
         Command::Robustness(args) => robustness::run(&args),
+        Command::Sweep(args) => sweep::run_sweep(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -6,9 +6,7 @@
 use super::settings::Settings;
 use super::{ControllerProduct, description, table};
 use eigenmpc::mpc::Variant;
-use fmi2_slave::Value;
-use fmi2_slave::values::Values;
-use fmi2_slave::variables::{BaseType, Causality};
+use fmi2_slave::table::named_value;
 
 /// The settings of product `P` with the parameters `(name, value)` set over
 /// its defaults, each checked as `fmi2SetReal` / `fmi2SetInteger` would
@@ -19,18 +17,11 @@ use fmi2_slave::variables::{BaseType, Causality};
 pub fn settings_from_named<P: ControllerProduct<N>, const N: usize>(
     values: &[(&str, f64)],
 ) -> Result<Settings<N>, String> {
-    let d = description::<P, N>();
-    let mut current = Values::new(&d);
-    for &(name, x) in values {
-        let (v, value) = checked(&d, P::MODEL_NAME, name, x)?;
-        let index = current
-            .index(v.var_type.base(), v.value_reference)
-            .ok_or_else(|| format!("{name}: no value slot"))?;
-        current.set_at(index, value);
-    }
-    let mut settings = P::settings(Variant::Curved);
-    table::table::<N>().read(&current, &mut settings, |_| true);
-    Ok(settings)
+    table::table::<N>().settings_from_named(
+        &description::<P, N>(),
+        P::settings(Variant::Curved),
+        values,
+    )
 }
 
 /// Checks `name = x` as `fmi2Set*` would for product `P` (a value for a
@@ -39,33 +30,7 @@ pub fn check_named<P: ControllerProduct<N>, const N: usize>(
     name: &str,
     x: f64,
 ) -> Result<(), String> {
-    checked(&description::<P, N>(), P::MODEL_NAME, name, x).map(|_| ())
-}
-
-/// The parameter `name` of `d` and `x` as its value, checked.
-fn checked<'d>(
-    d: &'d fmi2_slave::ModelDescription,
-    model: &str,
-    name: &str,
-    x: f64,
-) -> Result<(&'d fmi2_slave::Variable, Value), String> {
-    let v = d
-        .variable(name)
-        .ok_or_else(|| format!("{name} is not a variable of {model}"))?;
-    if v.causality != Causality::Parameter {
-        return Err(format!(
-            "{name} is not a parameter (it is set or read while running)"
-        ));
-    }
-    let value = match v.var_type.base() {
-        BaseType::Real => Value::Real(x),
-        BaseType::Boolean if x == 0.0 || x == 1.0 => Value::Boolean(x == 1.0),
-        BaseType::Boolean => return Err(format!("{name} = {x} must be 0 or 1 (Boolean)")),
-        _ if x.fract() == 0.0 && x.abs() <= i32::MAX as f64 => Value::Integer(x as i32),
-        _ => return Err(format!("{name} = {x} must be an integer")),
-    };
-    v.check_value(value)?;
-    Ok((v, value))
+    named_value(&description::<P, N>(), name, x).map(|_| ())
 }
 
 #[cfg(test)]
@@ -95,7 +60,7 @@ mod tests {
         assert_eq!(defaults, EigenMpc2::settings(Variant::Curved));
         for (pairs, needle) in [
             (vec![("m[3]", 1.0)], "m[3] is not a variable of EigenMPC"),
-            (vec![("q[1]", 0.1)], "q[1] is not a parameter"),
+            (vec![("q[1]", 0.1)], "q[1] is not a parameter of EigenMPC"),
             (vec![("horizon", 2.5)], "horizon = 2.5 must be an integer"),
             (
                 vec![("chart_source", 3.0)],

@@ -91,6 +91,19 @@ pub fn description<P: PlantProduct<N>, const N: usize>() -> ModelDescription {
     }
 }
 
+/// The plant settings of product `P` with the FMU parameters `(name, value)`
+/// set over the defaults, each checked as `fmi2Set*` would check it (as
+/// the controller's [`crate::controller::named::settings_from_named`]).
+pub fn settings_from_named<P: PlantProduct<N>, const N: usize>(
+    values: &[(&str, f64)],
+) -> Result<PlantSettings<N>, String> {
+    table::table::<N>().settings_from_named(
+        &description::<P, N>(),
+        PlantSettings::default(),
+        values,
+    )
+}
+
 impl<P: PlantProduct<N>, const N: usize, const NX: usize> Model for PlantFmu<P, N, NX> {
     fn description() -> ModelDescription {
         description::<P, N>()
