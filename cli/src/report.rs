@@ -39,6 +39,16 @@ pub fn number(x: f64) -> String {
     if text == "-0" { "0".into() } else { text }
 }
 
+/// What a summary's RMS figures cover: `last 5 s`, or `whole run (2 s)`
+/// for a run shorter than the 5 s window.
+pub fn window_label(window: f64) -> String {
+    if window < 5.0 - 1e-9 {
+        format!("whole run ({} s)", number(window))
+    } else {
+        format!("last {} s", number(window))
+    }
+}
+
 /// The summary figures as aligned text lines (time to 5 %, final energy
 /// error, RMS torque and distance over the last 5 s, solve times).
 pub fn summary_text<const N: usize>(s: &Summary<N>) -> String {
@@ -54,13 +64,16 @@ pub fn summary_text<const N: usize>(s: &Summary<N>) -> String {
         s.final_energy_error
     );
     let torques: Vec<String> = s.rms_torque.iter().map(|t| format!("{t:.4}")).collect();
+    let window = window_label(s.window);
     let _ = writeln!(
         out,
-        "RMS torque, last 5 s:            {} N m",
-        torques.join(" / ")
+        "RMS torque, {window}:{:pad$}{} N m",
+        "",
+        torques.join(" / "),
+        pad = 20usize.saturating_sub(window.len()).max(1)
     );
     if let Some(d) = s.rms_distance {
-        let _ = writeln!(out, "RMS distance to the mode, last 5 s: {d:.4} rad");
+        let _ = writeln!(out, "RMS distance to the mode, {window}: {d:.4} rad");
     }
     let _ = writeln!(
         out,
@@ -171,7 +184,7 @@ fn draw<DB: DrawingBackend, const N: usize, const NX: usize>(
 where
     DB::ErrorType: 'static,
 {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| PlotError(format!("{e:?}"));
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| PlotError(format!("{e}"));
     root.fill(&WHITE).map_err(err)?;
     let panels = root.split_evenly((2, N + 1));
     let t_end = trace.last().map_or(1.0, |s| s.time).max(1e-9);

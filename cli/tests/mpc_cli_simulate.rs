@@ -1,7 +1,7 @@
 //! `eigenmpc simulate`: summary, CSV columns, plots, clear errors.
 
 mod common;
-use common::eigenmpc;
+use common::{eigenmpc, eigenmpc_ok};
 
 #[test]
 fn simulate_writes_csv_and_plots() {
@@ -105,13 +105,40 @@ fn simulate_refuses_bad_input_with_a_message() {
             ],
             "nonexistent",
         ),
+        // Flag errors: one line and exit code 1, as every other error.
+        (vec!["simulate", "--bogus"], "unexpected argument '--bogus'"),
+        (vec!["simulate", "--duration"], "a value is required"),
+        // Output paths are checked before the run (a 3600 s run would
+        // otherwise end in the error).
+        (
+            vec!["simulate", "--duration", "3600", "--plot", "/tmp/x.jpg"],
+            "PNG or SVG",
+        ),
+        (
+            vec![
+                "simulate",
+                "--duration",
+                "3600",
+                "--csv",
+                "/nonexistent/run.csv",
+            ],
+            "--csv /nonexistent/run.csv: cannot write",
+        ),
     ] {
         let out = eigenmpc(&args);
         let stderr = String::from_utf8_lossy(&out.stderr);
-        assert!(!out.status.success(), "{args:?}");
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
         assert!(stderr.contains(needle), "{args:?}: {stderr}");
         assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        assert_eq!(stderr.trim().lines().count(), 1, "{args:?}: {stderr}");
     }
+}
+
+#[test]
+fn a_run_shorter_than_the_window_says_so() {
+    let stdout = eigenmpc_ok(&["simulate", "--duration", "2"]);
+    assert!(stdout.contains("RMS torque, whole run (2 s):"), "{stdout}");
+    assert!(!stdout.contains("last 5 s"), "{stdout}");
 }
 
 #[test]

@@ -245,6 +245,9 @@ pub struct Summary<const N: usize> {
     pub solve_time: [f64; 4],
     /// Samples whose status was not OK.
     pub failures: usize,
+    /// The window the RMS figures cover (s): the requested one, or the
+    /// whole run when it is shorter.
+    pub window: f64,
 }
 
 /// Quantile of sorted data (nearest rank).
@@ -368,6 +371,7 @@ pub fn summarise<const N: usize, const NX: usize>(
             times.last().copied().unwrap_or(f64::NAN),
         ],
         failures: trace.iter().filter(|s| !s.status.is_ok()).count(),
+        window: window.min(t_end - trace.first().map_or(0.0, |s| s.time)),
     }
 }
 

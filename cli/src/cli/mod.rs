@@ -158,7 +158,23 @@ pub fn parse_list(name: &str, text: &str) -> anyhow::Result<Vec<f64>> {
 
 /// Runs the CLI and maps errors to a one-line message and exit code 1.
 pub fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) if !e.use_stderr() => {
+            // --help, --version: clap's text on stdout, success.
+            let _ = e.print();
+            return ExitCode::SUCCESS;
+        }
+        Err(e) => {
+            // A flag error: clap's first line (what is wrong), exit code 1
+            // like every other error.
+            let text = e.render().to_string();
+            let first = text.lines().next().unwrap_or("invalid arguments");
+            let first = first.strip_prefix("error: ").unwrap_or(first);
+            eprintln!("error: {first} (see --help)");
+            return ExitCode::FAILURE;
+        }
+    };
     let result = match cli.command {
         Command::Modes(args) => modes::run(&args),
         Command::Simulate(args) => simulate::run_simulate(&args),

@@ -14,7 +14,7 @@ use eigenmpc::mpc::{
     Controller, EstimatorConfig, MpcConfig, QpBackend, Reference, Variant,
     prediction_coulomb_sharpness, prediction_substeps,
 };
-use eigenmpc_cli::report::{plot_run, summary_text, write_csv};
+use eigenmpc_cli::report::{plot_run, summary_text, window_label, write_csv};
 use nalgebra::SVector;
 use std::path::{Path, PathBuf};
 
@@ -199,6 +199,22 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
     if !(args.energy.is_finite() && args.energy > 0.0) {
         bail!("--energy must be finite and > 0");
     }
+    // Output paths are checked now, not after the run.
+    if let Some(path) = &args.plot {
+        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+        if !ext.eq_ignore_ascii_case("png") && !ext.eq_ignore_ascii_case("svg") {
+            bail!(
+                "--plot {}: the plot is written as PNG or SVG: give a name ending in .png or .svg",
+                path.display()
+            );
+        }
+    }
+    for (flag, path) in [("csv", &args.csv), ("plot", &args.plot)] {
+        if let Some(path) = path {
+            std::fs::File::create(path)
+                .with_context(|| format!("--{flag} {}: cannot write", path.display()))?;
+        }
+    }
     let schedule = match &args.e_ref_at {
         Some(text) => parse_schedule(text)?,
         None => vec![],
@@ -327,15 +343,18 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
     let summary = summarise(&trace, e_final, Some(&mode.path), 5.0);
     print_summary(args, variant, family, &summary);
     let (mean, rms) = energy_tail(&trace, e_final, 5.0);
+    let window = window_label(summary.window);
     println!(
-        "energy, last 5 s:               mean {mean:.4} J ({:+.2} %), RMS error {rms:.4} J",
-        100.0 * (mean - e_final) / e_final
+        "energy, {window}:{:pad$}mean {mean:.4} J ({:+.2} %), RMS error {rms:.4} J",
+        "",
+        100.0 * (mean - e_final) / e_final,
+        pad = 24usize.saturating_sub(window.len()).max(1)
     );
     if plant.params().has_friction() {
         let f = rms_friction_torque(&trace, &plant, 5.0);
         let t = summary.rms_torque;
         println!(
-            "RMS friction torque along the final orbit, last 5 s: {:.4} / {:.4} N m (torque / friction: {:.2} / {:.2}, combined {:.2})",
+            "RMS friction torque along the final orbit, {window}: {:.4} / {:.4} N m (torque / friction: {:.2} / {:.2}, combined {:.2})",
             f[0],
             f[1],
             t[0] / f[0],

@@ -478,14 +478,15 @@ mod tests {
             .insert("controller.alpha".into(), Axis::List(vec![0.0, 1.0]));
         let runs = spec.runs().unwrap();
         assert_eq!(runs.len(), 6);
-        // Name order: alpha (slowest), then E_ref.
+        // Byte order of the names: E_ref (slowest) before alpha.
         assert_eq!(
             runs[1],
             vec![
-                ("controller.alpha".to_string(), 0.0),
-                ("controller.E_ref".to_string(), 4.0)
+                ("controller.E_ref".to_string(), 2.0),
+                ("controller.alpha".to_string(), 1.0)
             ]
         );
+        assert_eq!(runs[5][0], ("controller.E_ref".to_string(), 6.0));
         spec.random = Some(RandomSample {
             samples: 2,
             seed: 7,

@@ -147,7 +147,7 @@ pub fn plot(
     let svg = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("svg"));
-    let size = (960, 640);
+    let size = (960, 660);
     if svg {
         draw(
             SVGBackend::new(path, size).into_drawing_area(),
@@ -251,6 +251,9 @@ where
         let (hx, hy) = (half(&xs), half(&ys));
         let (vlo, vhi) = span(rows.iter().map(value));
         let (main, bar) = root.split_horizontally(800);
+        // A strip under the map for the note on missing values.
+        let height = main.dim_in_pixel().1;
+        let (main, note) = main.split_vertically(height.saturating_sub(26));
         let mut chart = ChartBuilder::on(&main)
             .margin(16)
             .x_label_area_size(52)
@@ -295,6 +298,14 @@ where
                 Text::new(text, (r.values[0].1, r.values[1].1), style)
             }))
             .map_err(err)?;
+        if rows.iter().any(|r| !value(r).is_finite()) {
+            note.draw(&Text::new(
+                "grey, -: no value (never in the band, no mode there, or a failed run)",
+                (90, 4),
+                ("sans-serif", 14).into_font().color(&RGBColor(90, 90, 90)),
+            ))
+            .map_err(err)?;
+        }
         // Colour bar with the metric's range.
         let mut scale = ChartBuilder::on(&bar)
             .margin_top(16)
