@@ -89,6 +89,15 @@ pub fn summary_text<const N: usize>(s: &Summary<N>) -> String {
     out
 }
 
+/// First time after which the energy stays within 5 % of `e_ref` (as
+/// `summarise`'s `time_to_5_percent`).
+pub fn band_entry<const N: usize, const NX: usize>(
+    trace: &[Sample<N, NX>],
+    e_ref: f64,
+) -> Option<f64> {
+    eigenmpc::mpc::closed_loop::summarise(trace, e_ref, None, 5.0).time_to_5_percent
+}
+
 /// Writes a run as CSV with the columns
 /// `time,q1..qN,qd1..qdN,tau1..tauN,energy,solve_ms`.
 pub fn write_csv<const N: usize, const NX: usize>(
@@ -122,6 +131,15 @@ enum Panel {
     Torque(usize),
 }
 
+/// Subscript digits for the joint index in labels (theta_1, tau_2).
+fn subscript(j: usize) -> String {
+    (j + 1)
+        .to_string()
+        .chars()
+        .map(|c| char::from_u32(0x2080 + c.to_digit(10).unwrap_or(0)).unwrap_or(c))
+        .collect()
+}
+
 impl Panel {
     fn value<const N: usize, const NX: usize>(self, s: &Sample<N, NX>) -> f64 {
         match self {
@@ -134,27 +152,44 @@ impl Panel {
     fn title_and_label(self) -> (String, String) {
         match self {
             Panel::Energy => ("energy".into(), "E (J)".into()),
-            Panel::Angle(j) => (format!("theta{}", j + 1), format!("theta{} (rad)", j + 1)),
-            Panel::Torque(j) => (format!("tau{}", j + 1), format!("tau{} (N m)", j + 1)),
+            Panel::Angle(j) => (
+                format!("joint angle \u{3b8}{}", subscript(j)),
+                format!("\u{3b8}{} (rad)", subscript(j)),
+            ),
+            Panel::Torque(j) => (
+                format!("joint torque \u{3c4}{}", subscript(j)),
+                format!("\u{3c4}{} (N m)", subscript(j)),
+            ),
         }
     }
+}
+
+/// What a run's plot says besides the data.
+#[derive(Clone, Debug, Default)]
+pub struct PlotInfo {
+    /// The figure's title: variant, family, `E_ref`, start state.
+    pub caption: String,
+    /// The torque bound, drawn on the torque panels (N m).
+    pub tau_max: Option<f64>,
 }
 
 const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
 /// Draws the paper-style panels of a run (joint-space path in theta1,
-/// theta2 with the true eigenmode, energy, every theta_j, every tau_j): PNG,
-/// or SVG when the file name ends in `.svg`.
+/// theta2 coloured by time over the true eigenmode, energy with the 5 %
+/// band, every theta_j, every tau_j with the torque bound) under the
+/// caption of `info`: PNG, or SVG when the file name ends in `.svg`.
 pub fn plot_run<const N: usize, const NX: usize>(
     path: &Path,
     trace: &[Sample<N, NX>],
     mode: &[Vector<N>],
     e_ref: f64,
+    info: &PlotInfo,
 ) -> Result<(), PlotError> {
     const { assert!(N >= 2, "the joint-space panel needs two joints") };
     // The font ships with the binary: no system fontconfig needed.
     register_font()?;
-    let size = (500 * (N as u32 + 1), 900);
+    let size = (520 * (N as u32 + 1), 960);
     let svg = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("svg"));
@@ -164,6 +199,7 @@ pub fn plot_run<const N: usize, const NX: usize>(
             trace,
             mode,
             e_ref,
+            info,
         )
     } else {
         draw(
@@ -171,8 +207,17 @@ pub fn plot_run<const N: usize, const NX: usize>(
             trace,
             mode,
             e_ref,
+            info,
         )
     }
+}
+
+/// Colour of time `f` in [0, 1] along the path: light blue at the start,
+/// dark blue at the end.
+fn time_colour(f: f64) -> RGBColor {
+    let f = f.clamp(0.0, 1.0);
+    let mix = |a: f64, b: f64| (a + (b - a) * f).round() as u8;
+    RGBColor(mix(180.0, 8.0), mix(205.0, 48.0), mix(235.0, 107.0))
 }
 
 fn draw<DB: DrawingBackend, const N: usize, const NX: usize>(
@@ -180,23 +225,45 @@ fn draw<DB: DrawingBackend, const N: usize, const NX: usize>(
     trace: &[Sample<N, NX>],
     mode: &[Vector<N>],
     e_ref: f64,
+    info: &PlotInfo,
 ) -> Result<(), PlotError>
 where
     DB::ErrorType: 'static,
 {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| PlotError(format!("{e}"));
     root.fill(&WHITE).map_err(err)?;
+    let root = if info.caption.is_empty() {
+        root
+    } else {
+        root.titled(&info.caption, ("sans-serif", 22))
+            .map_err(err)?
+    };
     let panels = root.split_evenly((2, N + 1));
-    let t_end = trace.last().map_or(1.0, |s| s.time).max(1e-9);
+    let t_start = trace.first().map_or(0.0, |s| s.time);
+    let t_end = trace.last().map_or(1.0, |s| s.time).max(t_start + 1e-9);
+    let tail_start = t_end - 5.0;
     let range = |vals: &mut dyn Iterator<Item = f64>| {
-        let (lo, hi) = vals.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-            (a.min(v), b.max(v))
-        });
-        let pad = ((hi - lo) * 0.05).max(1e-3);
+        let (lo, hi) = vals
+            .filter(|v| v.is_finite())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                (a.min(v), b.max(v))
+            });
+        if !lo.is_finite() {
+            return -1.0..1.0;
+        }
+        let pad = ((hi - lo) * 0.06).max(1e-3);
         (lo - pad)..(hi + pad)
     };
+    let label_font = ("sans-serif", 16);
+    let desc_font = ("sans-serif", 17);
+    let caption_font = ("sans-serif", 19);
+    let blue = RGBColor(8, 48, 107);
+    let red = RGBColor(214, 39, 40);
+    let grey = RGBColor(120, 120, 120);
 
-    // Joint-space path with the true eigenmode (both branches of the orbit).
+    // Joint-space path: the true eigenmode underneath as a broad light
+    // band, the closed loop on top coloured by time (the last 5 s bold), so
+    // that the final orbit can be compared with the mode.
     {
         let xs = range(
             &mut trace
@@ -211,76 +278,199 @@ where
                 .chain(mode.iter().map(|q| q[1])),
         );
         let mut chart = ChartBuilder::on(&panels[0])
-            .caption("joint-space path", ("sans-serif", 20))
-            .margin(10)
-            .x_label_area_size(35)
-            .y_label_area_size(45)
+            .caption("joint-space path", caption_font)
+            .margin(12)
+            .margin_right(28)
+            .x_label_area_size(44)
+            .y_label_area_size(60)
             .build_cartesian_2d(xs, ys)
             .map_err(err)?;
         chart
             .configure_mesh()
-            .x_desc("theta1 (rad)")
-            .y_desc("theta2 (rad)")
+            .x_desc(format!("\u{3b8}{} (rad)", subscript(0)))
+            .y_desc(format!("\u{3b8}{} (rad)", subscript(1)))
+            .x_label_formatter(&|v| number(*v))
+            .y_label_formatter(&|v| number(*v))
+            .label_style(label_font)
+            .axis_desc_style(desc_font)
             .draw()
             .map_err(err)?;
-        chart
-            .draw_series(LineSeries::new(
-                trace.iter().map(|s| (s.state[0], s.state[1])),
-                BLUE.mix(0.6),
-            ))
-            .map_err(err)?
-            .label("EigenMPC")
-            .legend(|(x, y)| PathElement::new([(x, y), (x + 15, y)], BLUE));
+        let band = red.mix(0.3);
         chart
             .draw_series(LineSeries::new(
                 mode.iter().map(|q| (q[0], q[1])),
-                RED.stroke_width(2),
+                band.stroke_width(7),
             ))
             .map_err(err)?
-            .label("eigenmode at E_ref")
-            .legend(|(x, y)| PathElement::new([(x, y), (x + 15, y)], RED));
+            .label("plant's eigenmode at E_ref")
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], band.stroke_width(7)));
+        let span = (t_end - t_start).max(1e-9);
+        chart
+            .draw_series(trace.windows(2).map(|w| {
+                let f = (w[1].time - t_start) / span;
+                let width = if w[1].time > tail_start { 2 } else { 1 };
+                PathElement::new(
+                    [
+                        (w[0].state[0], w[0].state[1]),
+                        (w[1].state[0], w[1].state[1]),
+                    ],
+                    time_colour(f).stroke_width(width),
+                )
+            }))
+            .map_err(err)?
+            .label("EigenMPC, light to dark over time")
+            .legend(move |(x, y)| {
+                PathElement::new([(x, y), (x + 18, y)], time_colour(0.3).stroke_width(2))
+            });
+        chart
+            .draw_series(std::iter::once(PathElement::new(
+                Vec::<(f64, f64)>::new(),
+                blue.stroke_width(2),
+            )))
+            .map_err(err)?
+            .label("last 5 s (bold)")
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], blue.stroke_width(3)));
         chart
             .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
+            .position(SeriesLabelPosition::UpperLeft)
+            .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
+            .label_font(("sans-serif", 14))
             .draw()
             .map_err(err)?;
     }
 
+    let band = 0.05 * e_ref.abs();
+    let reached = crate::report::band_entry(trace, e_ref);
     let series: Vec<Panel> = std::iter::once(Panel::Energy)
         .chain((0..N).map(Panel::Angle))
         .chain((0..N).map(Panel::Torque))
         .collect();
     for (panel, what) in panels[1..].iter().zip(series) {
         let (title, label) = what.title_and_label();
-        let energy = matches!(what, Panel::Energy);
         let mut ys = range(&mut trace.iter().map(|s| what.value(s)));
-        if energy {
-            ys = ys.start.min(e_ref * 0.9)..ys.end.max(e_ref * 1.1);
+        match what {
+            Panel::Energy => {
+                ys = ys.start.min(e_ref - 2.0 * band)..ys.end.max(e_ref + 2.0 * band);
+            }
+            Panel::Torque(_) => {
+                if let Some(m) = info.tau_max {
+                    ys = ys.start.min(-1.1 * m)..ys.end.max(1.1 * m);
+                }
+            }
+            Panel::Angle(_) => {}
         }
         let mut chart = ChartBuilder::on(panel)
-            .caption(&title, ("sans-serif", 20))
-            .margin(10)
-            .x_label_area_size(35)
-            .y_label_area_size(45)
-            .build_cartesian_2d(0.0..t_end, ys)
+            .caption(&title, caption_font)
+            .margin(12)
+            .margin_right(28)
+            .x_label_area_size(44)
+            .y_label_area_size(60)
+            .build_cartesian_2d(t_start..t_end, ys.clone())
             .map_err(err)?;
         chart
             .configure_mesh()
             .x_desc("time (s)")
             .y_desc(&label)
+            .x_label_formatter(&|v| number(*v))
+            .y_label_formatter(&|v| number(*v))
+            .label_style(label_font)
+            .axis_desc_style(desc_font)
             .draw()
             .map_err(err)?;
-        chart
-            .draw_series(LineSeries::new(
-                trace.iter().map(|s| (s.time, what.value(s))),
-                BLUE,
-            ))
-            .map_err(err)?;
-        if energy {
-            chart
-                .draw_series(LineSeries::new([(0.0, e_ref), (t_end, e_ref)], RED))
-                .map_err(err)?;
+        match what {
+            Panel::Energy => {
+                // The band first, E_ref under the trace: the trace's end stays visible.
+                let fill = RGBColor(44, 160, 44).mix(0.18);
+                chart
+                    .draw_series(std::iter::once(Rectangle::new(
+                        [(t_start, e_ref - band), (t_end, e_ref + band)],
+                        fill.filled(),
+                    )))
+                    .map_err(err)?
+                    .label("5 % band")
+                    .legend(move |(x, y)| {
+                        Rectangle::new([(x, y - 5), (x + 18, y + 5)], fill.filled())
+                    });
+                chart
+                    .draw_series(LineSeries::new([(t_start, e_ref), (t_end, e_ref)], red))
+                    .map_err(err)?
+                    .label(format!("E_ref = {} J", number(e_ref)))
+                    .legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], red));
+                chart
+                    .draw_series(LineSeries::new(
+                        trace.iter().map(|s| (s.time, s.energy)),
+                        blue.stroke_width(2),
+                    ))
+                    .map_err(err)?
+                    .label("plant energy")
+                    .legend(move |(x, y)| {
+                        PathElement::new([(x, y), (x + 18, y)], blue.stroke_width(2))
+                    });
+                if let Some(t) = reached {
+                    chart
+                        .draw_series(LineSeries::new(
+                            [(t, ys.start), (t, ys.end)],
+                            grey.stroke_width(1),
+                        ))
+                        .map_err(err)?
+                        .label(format!("in the band for good: {} s", number(t)))
+                        .legend(move |(x, y)| {
+                            PathElement::new([(x + 9, y - 6), (x + 9, y + 6)], grey)
+                        });
+                }
+                chart
+                    .configure_series_labels()
+                    .position(SeriesLabelPosition::LowerRight)
+                    .background_style(WHITE.mix(0.85))
+                    .border_style(BLACK)
+                    .label_font(("sans-serif", 14))
+                    .draw()
+                    .map_err(err)?;
+            }
+            Panel::Torque(_) => {
+                chart
+                    .draw_series(LineSeries::new(
+                        trace.iter().map(|s| (s.time, what.value(s))),
+                        blue,
+                    ))
+                    .map_err(err)?
+                    .label("applied torque")
+                    .legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], blue));
+                if let Some(m) = info.tau_max {
+                    let bound = red.mix(0.7);
+                    for level in [-m, m] {
+                        let line = chart
+                            .draw_series(LineSeries::new(
+                                [(t_start, level), (t_end, level)],
+                                bound.stroke_width(2),
+                            ))
+                            .map_err(err)?;
+                        if level > 0.0 {
+                            line.label(format!("\u{b1}\u{3c4}_max = \u{b1}{} N m", number(m)))
+                                .legend(move |(x, y)| {
+                                    PathElement::new([(x, y), (x + 18, y)], bound.stroke_width(2))
+                                });
+                        }
+                    }
+                }
+                chart
+                    .configure_series_labels()
+                    .position(SeriesLabelPosition::LowerRight)
+                    .background_style(WHITE.mix(0.85))
+                    .border_style(BLACK)
+                    .label_font(("sans-serif", 14))
+                    .draw()
+                    .map_err(err)?;
+            }
+            Panel::Angle(_) => {
+                chart
+                    .draw_series(LineSeries::new(
+                        trace.iter().map(|s| (s.time, what.value(s))),
+                        blue,
+                    ))
+                    .map_err(err)?;
+            }
         }
     }
     root.present().map_err(err)?;

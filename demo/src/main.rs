@@ -20,7 +20,7 @@ use eigenmpc::model_file::RobotFile;
 use eigenmpc::modes::Family;
 use eigenmpc::mpc::ControlStatus;
 use eigenmpc::mpc::closed_loop::{Sample, mode_and_chart, summarise};
-use eigenmpc_cli::report::{plot_run, summary_text, write_csv};
+use eigenmpc_cli::report::{PlotInfo, plot_run, summary_text, write_csv};
 use eigenmpc_fmu_models::controller::start_values::model_start_values;
 use fmi::fmi2::Fmi2Res;
 use fmi::fmi2::import::Fmi2Import;
@@ -345,9 +345,18 @@ fn co_simulate<const N: usize, const NX: usize>(
         .with_context(|| format!("creating {}", args.out_dir.display()))?;
     let csv = args.out_dir.join("demo.csv");
     write_csv(&csv, &trace).with_context(|| format!("writing {}", csv.display()))?;
+    let info = PlotInfo {
+        caption: format!(
+            "{controller_name}.fmu drives {plant_name}.fmu: curved, in-phase, E_ref = {} J, \
+             |\u{3c4}| \u{2264} {tau_max} N m, q0 = ({}), sample period {h} s",
+            args.energy,
+            q0_text.join(", ")
+        ),
+        tau_max: Some(tau_max),
+    };
     for name in ["demo.png", "demo.svg"] {
         let path = args.out_dir.join(name);
-        plot_run(&path, &trace, &mode.path, args.energy)?;
+        plot_run(&path, &trace, &mode.path, args.energy, &info)?;
     }
     println!(
         "wrote {}, {} and {}",

@@ -14,7 +14,7 @@ use eigenmpc::mpc::{
     Controller, EstimatorConfig, MpcConfig, QpBackend, Reference, Variant,
     prediction_coulomb_sharpness, prediction_substeps,
 };
-use eigenmpc_cli::report::{plot_run, summary_text, window_label, write_csv};
+use eigenmpc_cli::report::{PlotInfo, number, plot_run, summary_text, window_label, write_csv};
 use nalgebra::SVector;
 use std::path::{Path, PathBuf};
 
@@ -348,7 +348,7 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
         "energy, {window}:{:pad$}mean {mean:.4} J ({:+.2} %), RMS error {rms:.4} J",
         "",
         100.0 * (mean - e_final) / e_final,
-        pad = 24usize.saturating_sub(window.len()).max(1)
+        pad = 23usize.saturating_sub(window.len()).max(1)
     );
     if plant.params().has_friction() {
         let f = rms_friction_torque(&trace, &plant, 5.0);
@@ -371,7 +371,18 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
         write_csv(path, &trace).with_context(|| format!("writing {}", path.display()))?;
     }
     if let Some(path) = &args.plot {
-        plot_run(path, &trace, &mode.path, e_final)
+        let info = PlotInfo {
+            caption: format!(
+                "{variant} EigenMPC, {family}, E_ref = {} J, x0 = ({}), |\u{3c4}| \u{2264} {} N m, N = {}, dt = {} s",
+                number(e_final),
+                x0.iter().map(|v| number(*v)).collect::<Vec<_>>().join(", "),
+                number(args.tau_max),
+                args.horizon,
+                number(args.dt)
+            ),
+            tau_max: Some(args.tau_max),
+        };
+        plot_run(path, &trace, &mode.path, e_final, &info)
             .with_context(|| format!("plotting {}", path.display()))?;
     }
     Ok(())
