@@ -114,13 +114,20 @@ fn bad_input_gives_one_line_errors_and_nonzero_exit() {
             vec!["modes", "--energies", "70"],
             "cannot be continued beyond",
         ),
+        // A nearly massless second link: the family by its name, and the
+        // energy asked for (not the continuation's internal start).
+        (
+            vec!["modes", "--energies", "14", "--m2", "1e-9"],
+            "the in-phase family cannot be continued beyond E = 0.0000 J (requested 14 J): no orbit \
+             at the continuation's start energy 0.05 J",
+        ),
         (
             vec!["modes", "--energies", "2", "--samples", "5"],
             "too few",
         ),
     ] {
         let (code, stdout, stderr) = run(&args);
-        assert_ne!(code, 0, "{args:?} should fail");
+        assert_eq!(code, 1, "{args:?} should fail with exit code 1");
         assert!(stdout.is_empty(), "{args:?} printed {stdout}");
         assert!(stderr.contains(needle), "{args:?}: {stderr}");
         assert_eq!(stderr.trim_end().lines().count(), 1, "{args:?}: {stderr}");
@@ -268,5 +275,8 @@ fn a_bad_parameter_file_gives_a_one_line_error_naming_key_and_file() {
         "--m1",
         "2",
     ]);
-    assert_eq!(code, 2, "clap refuses --m1 with --model: {stderr}");
+    // Flag errors too: one line, exit code 1.
+    assert_eq!(code, 1, "clap refuses --m1 with --model: {stderr}");
+    assert!(stderr.contains("'--model <FILE>' cannot be used with '--m1 <M1>'"), "{stderr}");
+    assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
 }

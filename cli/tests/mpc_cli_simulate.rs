@@ -108,6 +108,10 @@ fn simulate_refuses_bad_input_with_a_message() {
         // Flag errors: one line and exit code 1, as every other error.
         (vec!["simulate", "--bogus"], "unexpected argument '--bogus'"),
         (vec!["simulate", "--duration"], "a value is required"),
+        (
+            vec!["modes"],
+            "required arguments were not provided: --energies <ENERGIES>",
+        ),
         // Output paths are checked before the run (a 3600 s run would
         // otherwise end in the error).
         (

@@ -288,7 +288,7 @@ where
         index: mode_index,
         dof: N,
     })?;
-    let family = format!("family of linear mode {mode_index}");
+    let family = super::family_name(N, mode_index);
     let q_eq = system.equilibrium();
     let c = mode.eigenvector;
     let stiffness = c.dot(&(system.potential_hessian(&q_eq) * c));
@@ -309,8 +309,13 @@ where
         requested,
         reason,
     };
-    let first =
-        shoot::<_, N, NX>(system, e_start, guess, opts).map_err(|r| fail(0.0, e_start, r))?;
+    let first = shoot::<_, N, NX>(system, e_start, guess, opts).map_err(|r| {
+        fail(
+            0.0,
+            lowest,
+            format!("no orbit at the continuation's start energy {e_start} J: {r}"),
+        )
+    })?;
     // History for the secant predictor, parametrised by sqrt(E) (amplitude
     // grows like sqrt(E) near the equilibrium).
     let mut prev: Option<(f64, Shot<N>)> = None;

@@ -212,7 +212,7 @@ impl<const N: usize> ChartFamily<N> {
         };
         if family.energies.len() < 2 {
             return Err(ModeError::ContinuationFailed {
-                family: format!("family of linear mode {mode_index}"),
+                family: super::family_name(N, mode_index),
                 reached: family.energies.last().copied().unwrap_or(0.0),
                 requested: opts.energy_max,
                 reason: family

@@ -18,6 +18,17 @@ pub use linear::{Family, LinearMode, linear_modes};
 
 use crate::integrate::IntegrationError;
 
+/// The name of the family of linear mode `mode_index` (ascending frequency)
+/// of an `n`-joint system in messages: the 2-link chain's by [`Family`]
+/// (in-phase, anti-phase), others by index.
+pub fn family_name(n: usize, mode_index: usize) -> String {
+    match (n, mode_index) {
+        (2, 0) => format!("{} family", Family::InPhase),
+        (2, 1) => format!("{} family", Family::AntiPhase),
+        _ => format!("family of linear mode {mode_index} (ascending frequency)"),
+    }
+}
+
 use thiserror::Error;
 
 /// Why a mode, family or chart could not be computed.

@@ -168,9 +168,16 @@ pub fn main() -> ExitCode {
         Err(e) => {
             // A flag error: clap's first line (what is wrong), exit code 1
             // like every other error.
+            // The first paragraph (e.g. "required arguments were not
+            // provided:" and the list of them), on one line.
             let text = e.render().to_string();
-            let first = text.lines().next().unwrap_or("invalid arguments");
-            let first = first.strip_prefix("error: ").unwrap_or(first);
+            let first: Vec<&str> = text
+                .lines()
+                .take_while(|l| !l.trim().is_empty())
+                .map(str::trim)
+                .collect();
+            let first = first.join(" ");
+            let first = first.strip_prefix("error: ").unwrap_or(&first);
             eprintln!("error: {first} (see --help)");
             return ExitCode::FAILURE;
         }
