@@ -277,6 +277,9 @@ fn a_bad_parameter_file_gives_a_one_line_error_naming_key_and_file() {
     ]);
     // Flag errors too: one line, exit code 1.
     assert_eq!(code, 1, "clap refuses --m1 with --model: {stderr}");
-    assert!(stderr.contains("'--model <FILE>' cannot be used with '--m1 <M1>'"), "{stderr}");
+    assert!(
+        stderr.contains("'--model <FILE>' cannot be used with '--m1 <M1>'"),
+        "{stderr}"
+    );
     assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
 }
