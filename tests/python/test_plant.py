@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from fmpy import simulate_fmu
 from fmpy.fmi1 import FMICallException
+from fmpy.fmi2 import fmi2FMUstate
 from fmpy.validation import validate_fmu
 
 from fmi_host import Slave, pendulum_energy
@@ -103,7 +104,15 @@ def test_bad_calls_are_errors_not_crashes(plant_md, plant_unzipped):
     expect_error(s, lambda: s.fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=-0.1), "must be finite and > 0")
     s.fmu.reset()
     s.initialize(SWING)
-    expect_error(s, s.fmu.getFMUstate, "fmi2GetFMUstate: not supported")
+    expect_error(
+        s,
+        lambda: s.fmu.getDirectionalDerivative([s.vr["q[1]"]], [s.vr["tau[1]"]], [1.0]),
+        "fmi2GetDirectionalDerivative: not supported",
+    )
+    s.fmu.reset()
+    s.initialize(SWING)
+    # A pointer that is not one of this FMU's states is refused, not used.
+    expect_error(s, lambda: s.fmu.setFMUstate(fmi2FMUstate(0x1234)), "fmi2SetFMUstate", "not a live state")
     # after all that, the instance still works
     s.fmu.reset()
     s.initialize(SWING)
