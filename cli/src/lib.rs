@@ -4,6 +4,7 @@
 //! sweeps (`eigenmpc sweep`). The core crate and the FMU libraries stay free of the CLI,
 //! plotting and progress-bar crates.
 
+pub mod paper;
 pub mod report;
 pub mod robustness;
 pub mod sweep;

@@ -3,6 +3,7 @@
 
 use eigenmpc::mechanics::Vector;
 use eigenmpc::mpc::closed_loop::{Sample, Summary};
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use std::fmt::Write as _;
 use std::io::Write;
@@ -241,104 +242,8 @@ where
     let panels = root.split_evenly((2, N + 1));
     let t_start = trace.first().map_or(0.0, |s| s.time);
     let t_end = trace.last().map_or(1.0, |s| s.time).max(t_start + 1e-9);
-    let tail_start = t_end - 5.0;
-    let range = |vals: &mut dyn Iterator<Item = f64>| {
-        let (lo, hi) = vals
-            .filter(|v| v.is_finite())
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-                (a.min(v), b.max(v))
-            });
-        if !lo.is_finite() {
-            return -1.0..1.0;
-        }
-        let pad = ((hi - lo) * 0.06).max(1e-3);
-        (lo - pad)..(hi + pad)
-    };
-    let label_font = ("sans-serif", 16);
-    let desc_font = ("sans-serif", 17);
-    let caption_font = ("sans-serif", 19);
-    let blue = RGBColor(8, 48, 107);
-    let red = RGBColor(214, 39, 40);
-    let grey = RGBColor(120, 120, 120);
-
-    // Joint-space path: the true eigenmode underneath as a broad light
-    // band, the closed loop on top coloured by time (the last 5 s bold), so
-    // that the final orbit can be compared with the mode.
-    {
-        let xs = range(
-            &mut trace
-                .iter()
-                .map(|s| s.state[0])
-                .chain(mode.iter().map(|q| q[0])),
-        );
-        let ys = range(
-            &mut trace
-                .iter()
-                .map(|s| s.state[1])
-                .chain(mode.iter().map(|q| q[1])),
-        );
-        let mut chart = ChartBuilder::on(&panels[0])
-            .caption("joint-space path", caption_font)
-            .margin(12)
-            .margin_right(28)
-            .x_label_area_size(44)
-            .y_label_area_size(60)
-            .build_cartesian_2d(xs, ys)
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc(format!("\u{3b8}{} (rad)", subscript(0)))
-            .y_desc(format!("\u{3b8}{} (rad)", subscript(1)))
-            .x_label_formatter(&|v| number(*v))
-            .y_label_formatter(&|v| number(*v))
-            .label_style(label_font)
-            .axis_desc_style(desc_font)
-            .draw()
-            .map_err(err)?;
-        let band = red.mix(0.3);
-        chart
-            .draw_series(LineSeries::new(
-                mode.iter().map(|q| (q[0], q[1])),
-                band.stroke_width(7),
-            ))
-            .map_err(err)?
-            .label("plant's eigenmode at E_ref")
-            .legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], band.stroke_width(7)));
-        let span = (t_end - t_start).max(1e-9);
-        chart
-            .draw_series(trace.windows(2).map(|w| {
-                let f = (w[1].time - t_start) / span;
-                let width = if w[1].time > tail_start { 2 } else { 1 };
-                PathElement::new(
-                    [
-                        (w[0].state[0], w[0].state[1]),
-                        (w[1].state[0], w[1].state[1]),
-                    ],
-                    time_colour(f).stroke_width(width),
-                )
-            }))
-            .map_err(err)?
-            .label("EigenMPC, light to dark over time")
-            .legend(move |(x, y)| {
-                PathElement::new([(x, y), (x + 18, y)], time_colour(0.3).stroke_width(2))
-            });
-        chart
-            .draw_series(std::iter::once(PathElement::new(
-                Vec::<(f64, f64)>::new(),
-                blue.stroke_width(2),
-            )))
-            .map_err(err)?
-            .label("last 5 s (bold)")
-            .legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], blue.stroke_width(3)));
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 14))
-            .draw()
-            .map_err(err)?;
-    }
+    let (blue, red, grey) = (BLUE_DARK, RED, GREY);
+    draw_path_panel(&panels[0], trace, mode, "joint-space path")?;
 
     let band = 0.05 * e_ref.abs();
     let reached = crate::report::band_entry(trace, e_ref);
@@ -348,7 +253,7 @@ where
         .collect();
     for (panel, what) in panels[1..].iter().zip(series) {
         let (title, label) = what.title_and_label();
-        let mut ys = range(&mut trace.iter().map(|s| what.value(s)));
+        let mut ys = padded_range(trace.iter().map(|s| what.value(s)));
         match what {
             Panel::Energy => {
                 ys = ys.start.min(e_ref - 2.0 * band)..ys.end.max(e_ref + 2.0 * band);
@@ -360,24 +265,8 @@ where
             }
             Panel::Angle(_) => {}
         }
-        let mut chart = ChartBuilder::on(panel)
-            .caption(&title, caption_font)
-            .margin(12)
-            .margin_right(28)
-            .x_label_area_size(44)
-            .y_label_area_size(60)
-            .build_cartesian_2d(t_start..t_end, ys.clone())
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc("time (s)")
-            .y_desc(&label)
-            .x_label_formatter(&|v| number(*v))
-            .y_label_formatter(&|v| number(*v))
-            .label_style(label_font)
-            .axis_desc_style(desc_font)
-            .draw()
-            .map_err(err)?;
+        let mut chart = panel_chart(panel, &title, t_start..t_end, ys.clone())?;
+        draw_mesh(&mut chart, "time (s)", &label)?;
         match what {
             Panel::Energy => {
                 // The band first, E_ref under the trace: the trace's end stays visible.
@@ -419,14 +308,7 @@ where
                             PathElement::new([(x + 9, y - 6), (x + 9, y + 6)], grey)
                         });
                 }
-                chart
-                    .configure_series_labels()
-                    .position(SeriesLabelPosition::LowerRight)
-                    .background_style(WHITE.mix(0.85))
-                    .border_style(BLACK)
-                    .label_font(("sans-serif", 14))
-                    .draw()
-                    .map_err(err)?;
+                draw_legend(&mut chart, SeriesLabelPosition::LowerRight)?;
             }
             Panel::Torque(_) => {
                 chart
@@ -454,14 +336,7 @@ where
                         }
                     }
                 }
-                chart
-                    .configure_series_labels()
-                    .position(SeriesLabelPosition::LowerRight)
-                    .background_style(WHITE.mix(0.85))
-                    .border_style(BLACK)
-                    .label_font(("sans-serif", 14))
-                    .draw()
-                    .map_err(err)?;
+                draw_legend(&mut chart, SeriesLabelPosition::LowerRight)?;
             }
             Panel::Angle(_) => {
                 chart
@@ -475,4 +350,206 @@ where
     }
     root.present().map_err(err)?;
     Ok(())
+}
+
+/// Dark blue of the closed-loop traces.
+pub const BLUE_DARK: RGBColor = RGBColor(8, 48, 107);
+/// Red of references (E_ref, the eigenmode band, the torque bound).
+pub const RED: RGBColor = RGBColor(214, 39, 40);
+/// Grey of markers and secondary references.
+pub const GREY: RGBColor = RGBColor(120, 120, 120);
+/// Orange of a final orbit compared with a reference (the paper's Fig. 3).
+pub const ORANGE: RGBColor = RGBColor(255, 127, 14);
+/// Blue of a true eigenmode (the paper's Fig. 3).
+pub const BLUE_MODE: RGBColor = RGBColor(31, 119, 180);
+
+/// The chart type of every panel: f64 on both axes.
+pub type Panel2d<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// The range of the finite `values`, padded by 6 % (-1..1 when there is none).
+pub fn padded_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+    if !lo.is_finite() {
+        return -1.0..1.0;
+    }
+    let pad = ((hi - lo) * 0.06).max(1e-3);
+    (lo - pad)..(hi + pad)
+}
+
+fn plot_error<E: std::error::Error + Send + Sync>(e: DrawingAreaErrorKind<E>) -> PlotError {
+    PlotError(format!("{e}"))
+}
+
+/// A panel with a caption, margins that keep the last tick label inside
+/// the image, and room for the axis labels.
+pub fn panel_chart<'a, DB: DrawingBackend + 'a>(
+    area: &'a DrawingArea<DB, plotters::coord::Shift>,
+    caption: &str,
+    xs: std::ops::Range<f64>,
+    ys: std::ops::Range<f64>,
+) -> Result<Panel2d<'a, DB>, PlotError>
+where
+    DB::ErrorType: 'static,
+{
+    ChartBuilder::on(area)
+        .caption(caption, ("sans-serif", 19))
+        .margin(12)
+        .margin_right(28)
+        .x_label_area_size(44)
+        .y_label_area_size(60)
+        .build_cartesian_2d(xs, ys)
+        .map_err(plot_error)
+}
+
+/// Grid, axis descriptions and `number()` tick labels (no `-0`).
+pub fn draw_mesh<'a, DB: DrawingBackend + 'a>(
+    chart: &mut Panel2d<'a, DB>,
+    x_desc: &str,
+    y_desc: &str,
+) -> Result<(), PlotError>
+where
+    DB::ErrorType: 'static,
+{
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .x_label_formatter(&|v| number(*v))
+        .y_label_formatter(&|v| number(*v))
+        .label_style(("sans-serif", 16))
+        .axis_desc_style(("sans-serif", 17))
+        .draw()
+        .map_err(plot_error)
+}
+
+/// The legend of the labelled series in a framed, slightly transparent box.
+pub fn draw_legend<'a, DB: DrawingBackend + 'a>(
+    chart: &mut Panel2d<'a, DB>,
+    position: SeriesLabelPosition,
+) -> Result<(), PlotError>
+where
+    DB::ErrorType: 'static,
+{
+    chart
+        .configure_series_labels()
+        .position(position)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .draw()
+        .map_err(plot_error)
+}
+
+/// A legend entry: a short line in `style`.
+pub fn legend_line(style: ShapeStyle) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
+    move |(x, y)| PathElement::new([(x, y), (x + 18, y)], style)
+}
+
+/// Joint-space panel of a run: the true eigenmode `mode` underneath as a
+/// broad light band, the closed loop on top coloured by time (the last 5 s
+/// bold), so that the final orbit can be compared with the mode.
+pub fn draw_path_panel<DB: DrawingBackend, const N: usize, const NX: usize>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    trace: &[Sample<N, NX>],
+    mode: &[Vector<N>],
+    caption: &str,
+) -> Result<(), PlotError>
+where
+    DB::ErrorType: 'static,
+{
+    let t_start = trace.first().map_or(0.0, |s| s.time);
+    let t_end = trace.last().map_or(1.0, |s| s.time).max(t_start + 1e-9);
+    let tail_start = t_end - 5.0;
+    let xs = padded_range(
+        trace
+            .iter()
+            .map(|s| s.state[0])
+            .chain(mode.iter().map(|q| q[0])),
+    );
+    let ys = padded_range(
+        trace
+            .iter()
+            .map(|s| s.state[1])
+            .chain(mode.iter().map(|q| q[1])),
+    );
+    let mut chart = panel_chart(area, caption, xs, ys)?;
+    draw_mesh(
+        &mut chart,
+        &format!("\u{3b8}{} (rad)", subscript(0)),
+        &format!("\u{3b8}{} (rad)", subscript(1)),
+    )?;
+    let band = RED.mix(0.3).stroke_width(7);
+    chart
+        .draw_series(LineSeries::new(mode.iter().map(|q| (q[0], q[1])), band))
+        .map_err(plot_error)?
+        .label("plant's eigenmode at E_ref")
+        .legend(legend_line(band));
+    let span = (t_end - t_start).max(1e-9);
+    chart
+        .draw_series(trace.windows(2).map(|w| {
+            let f = (w[1].time - t_start) / span;
+            let width = if w[1].time > tail_start { 2 } else { 1 };
+            PathElement::new(
+                [
+                    (w[0].state[0], w[0].state[1]),
+                    (w[1].state[0], w[1].state[1]),
+                ],
+                time_colour(f).stroke_width(width),
+            )
+        }))
+        .map_err(plot_error)?
+        .label("EigenMPC, light to dark over time")
+        .legend(legend_line(time_colour(0.3).stroke_width(2)));
+    chart
+        .draw_series(std::iter::once(PathElement::new(
+            Vec::<(f64, f64)>::new(),
+            BLUE_DARK.stroke_width(2),
+        )))
+        .map_err(plot_error)?
+        .label("last 5 s (bold)")
+        .legend(legend_line(BLUE_DARK.stroke_width(3)));
+    draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)
+}
+
+/// Viridis-like colour of `t` in [0, 1] (dark violet to yellow).
+pub fn viridis(t: f64) -> RGBColor {
+    const STOPS: [(f64, [u8; 3]); 5] = [
+        (0.0, [68, 1, 84]),
+        (0.25, [59, 82, 139]),
+        (0.5, [33, 145, 140]),
+        (0.75, [94, 201, 98]),
+        (1.0, [253, 231, 37]),
+    ];
+    let t = t.clamp(0.0, 1.0);
+    let i = STOPS.iter().rposition(|(s, _)| *s <= t).unwrap_or(0).min(3);
+    let (s0, c0) = STOPS[i];
+    let (s1, c1) = STOPS[i + 1];
+    let f = (t - s0) / (s1 - s0);
+    let mix = |a: u8, b: u8| (a as f64 + (b as f64 - a as f64) * f).round() as u8;
+    RGBColor(mix(c0[0], c1[0]), mix(c0[1], c1[1]), mix(c0[2], c1[2]))
+}
+
+/// Draws `draw(root)` into a PNG, or an SVG when `path` ends in `.svg`,
+/// on a white background with the embedded font.
+pub fn with_backend(
+    path: &Path,
+    size: (u32, u32),
+    draw_png: impl FnOnce(
+        DrawingArea<BitMapBackend<'_>, plotters::coord::Shift>,
+    ) -> Result<(), PlotError>,
+    draw_svg: impl FnOnce(DrawingArea<SVGBackend<'_>, plotters::coord::Shift>) -> Result<(), PlotError>,
+) -> Result<(), PlotError> {
+    register_font()?;
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("svg"))
+    {
+        draw_svg(SVGBackend::new(path, size).into_drawing_area())
+    } else {
+        draw_png(BitMapBackend::new(path, size).into_drawing_area())
+    }
 }

@@ -2,6 +2,7 @@
 //! non-zero exit code, never as a panic trace.
 
 mod modes;
+mod paper;
 mod robustness;
 mod simulate;
 mod sweep;
@@ -32,6 +33,9 @@ enum Command {
     /// Closed loops over a grid or a random sample of controller, plant and set-up parameters,
     /// on all cores; CSV, JSON and a plot of one metric.
     Sweep(Box<sweep::SweepArgs>),
+    /// The paper's section V figures and the hybrid experiment from this engine, and
+    /// report.md with each claim of the paper next to the measured figure and a verdict.
+    Paper(paper::PaperArgs),
 }
 
 /// The robot: a parameter file, or the paper's point-mass double pendulum
@@ -145,6 +149,17 @@ impl Robot {
     }
 }
 
+/// Creates the output folder `dir` and checks that it is writable, so that
+/// a bad `--out` is found before any run, not after.
+pub fn prepare_out_dir(dir: &std::path::Path) -> anyhow::Result<()> {
+    use anyhow::Context;
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let probe = dir.join(".eigenmpc-write-test");
+    std::fs::write(&probe, b"").with_context(|| format!("cannot write into {}", dir.display()))?;
+    std::fs::remove_file(&probe).ok();
+    Ok(())
+}
+
 /// Parses a comma-separated list of numbers (`"2,8,14"`).
 pub fn parse_list(name: &str, text: &str) -> anyhow::Result<Vec<f64>> {
     text.split(',')
@@ -187,6 +202,7 @@ pub fn main() -> ExitCode {
         Command::Simulate(args) => simulate::run_simulate(&args),
         Command::Robustness(args) => robustness::run(&args),
         Command::Sweep(args) => sweep::run_sweep(&args),
+        Command::Paper(args) => paper::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

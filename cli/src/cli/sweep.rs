@@ -164,12 +164,7 @@ pub fn run_sweep(args: &SweepArgs) -> anyhow::Result<()> {
         })
         .collect::<anyhow::Result<Vec<_>>>()?;
     // An unwritable output folder is found now, not after the sweep.
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("creating {}", args.out.display()))?;
-    let probe = args.out.join(".sweep-write-test");
-    std::fs::write(&probe, b"")
-        .with_context(|| format!("cannot write into {}", args.out.display()))?;
-    std::fs::remove_file(&probe).ok();
+    super::prepare_out_dir(&args.out)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads.unwrap_or(0))
         .build()

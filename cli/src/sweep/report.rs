@@ -3,7 +3,7 @@
 //! parameters (a line for one, a heat map for two).
 
 use super::Metrics;
-use crate::report::{PlotError, number, register_font};
+use crate::report::{PlotError, number, register_font, viridis};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use serde_json::json;
@@ -187,24 +187,6 @@ fn span(values: impl Iterator<Item = f64>) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
-/// Viridis-like colour of `t` in [0, 1].
-fn colour(t: f64) -> RGBColor {
-    const STOPS: [(f64, [u8; 3]); 5] = [
-        (0.0, [68, 1, 84]),
-        (0.25, [59, 82, 139]),
-        (0.5, [33, 145, 140]),
-        (0.75, [94, 201, 98]),
-        (1.0, [253, 231, 37]),
-    ];
-    let t = t.clamp(0.0, 1.0);
-    let i = STOPS.iter().rposition(|(s, _)| *s <= t).unwrap_or(0).min(3);
-    let (s0, c0) = STOPS[i];
-    let (s1, c1) = STOPS[i + 1];
-    let f = (t - s0) / (s1 - s0);
-    let mix = |a: u8, b: u8| (a as f64 + (b as f64 - a as f64) * f).round() as u8;
-    RGBColor(mix(c0[0], c1[0]), mix(c0[1], c1[1]), mix(c0[2], c1[2]))
-}
-
 fn draw<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
     title: &str,
@@ -278,7 +260,7 @@ where
             .draw_series(rows.iter().map(|r| {
                 let (cx, cy, v) = (r.values[0].1, r.values[1].1, value(r));
                 let fill = if v.is_finite() {
-                    colour((v - vlo) / (vhi - vlo)).filled()
+                    viridis((v - vlo) / (vhi - vlo)).filled()
                 } else {
                     RGBColor(200, 200, 200).filled()
                 };
@@ -332,7 +314,7 @@ where
                 let b = vlo + (vhi - vlo) * (k + 1) as f64 / steps as f64;
                 Rectangle::new(
                     [(0.0, a), (1.0, b)],
-                    colour(k as f64 / (steps - 1) as f64).filled(),
+                    viridis(k as f64 / (steps - 1) as f64).filled(),
                 )
             }))
             .map_err(err)?;
