@@ -226,3 +226,46 @@ fn simulate_noise_with_and_without_the_estimator() {
         "with EKF {with}, without {without}"
     );
 }
+
+#[test]
+fn a_chart_of_the_other_family_is_refused() {
+    let path = std::env::temp_dir().join(format!("eigenmpc-anti-{}.json", std::process::id()));
+    let json = eigenmpc_ok(&["modes", "--family", "anti-phase", "--energies", "12"]);
+    std::fs::write(&path, json).unwrap();
+    let out = eigenmpc(&[
+        "simulate",
+        "--variant",
+        "curved",
+        "--family",
+        "in-phase",
+        "--energy",
+        "14",
+        "--chart",
+        path.to_str().unwrap(),
+        "--duration",
+        "1",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains(
+            "its modes are of the anti-phase family, this run follows the in-phase family"
+        ),
+        "{stderr}"
+    );
+    // The same file for an anti-phase run is taken.
+    eigenmpc_ok(&[
+        "simulate",
+        "--variant",
+        "curved",
+        "--family",
+        "anti-phase",
+        "--energy",
+        "12",
+        "--chart",
+        path.to_str().unwrap(),
+        "--duration",
+        "1",
+    ]);
+    std::fs::remove_file(&path).ok();
+}

@@ -118,8 +118,9 @@ pub struct SimulateArgs {
     model: ModelArgs,
 }
 
-/// Reads the chart of the mode closest to `energy` from `eigenmpc modes` JSON.
-fn chart_from_json(path: &Path, energy: f64) -> anyhow::Result<Chart<2>> {
+/// Reads the chart of the mode closest to `energy` from `eigenmpc modes`
+/// JSON; the file's modes must be of `family`.
+fn chart_from_json(path: &Path, energy: f64, family: Family) -> anyhow::Result<Chart<2>> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
     let doc: serde_json::Value =
@@ -133,6 +134,18 @@ fn chart_from_json(path: &Path, energy: f64) -> anyhow::Result<Chart<2>> {
         Ok(Vector::<2>::new(a[0], a[1]))
     };
     let eigenvector = vec2(&doc["linear"]["eigenvector"], "linear.eigenvector")?;
+    if let Some(name) = doc["family"].as_str() {
+        let theirs: Family = name
+            .parse()
+            .map_err(|e: String| anyhow::anyhow!("--chart {}: family: {e}", path.display()))?;
+        if theirs != family {
+            bail!(
+                "--chart {}: its modes are of the {theirs} family, this run follows the {family} family \
+                 (give --family {theirs}, or a chart from `eigenmpc modes --family {family}`)",
+                path.display()
+            );
+        }
+    }
     let modes = doc["modes"]
         .as_array()
         .context("the chart file has no `modes` list")?;
@@ -299,7 +312,7 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
             chart_variant => Reference::with_chart(
                 chart_variant,
                 match &args.chart {
-                    Some(path) => chart_from_json(path, args.energy)?,
+                    Some(path) => chart_from_json(path, args.energy, family)?,
                     None => {
                         mode_and_chart::<_, 2, 4>(
                             &model,
