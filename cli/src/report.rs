@@ -553,3 +553,78 @@ pub fn with_backend(
         draw_png(BitMapBackend::new(path, size).into_drawing_area())
     }
 }
+
+/// The corner of the plot box `xs` x `ys` with the fewest of `points` in
+/// its quarter-size box: where a legend hides the least data. Ties go to
+/// upper right, upper left, lower right, lower left, in that order.
+pub fn quiet_corner(
+    points: &[(f64, f64)],
+    xs: &std::ops::Range<f64>,
+    ys: &std::ops::Range<f64>,
+) -> SeriesLabelPosition {
+    let (w, h) = (0.5 * (xs.end - xs.start), 0.5 * (ys.end - ys.start));
+    let corners = [
+        (SeriesLabelPosition::UpperRight, xs.end - w, ys.end - h),
+        (SeriesLabelPosition::UpperLeft, xs.start, ys.end - h),
+        (SeriesLabelPosition::LowerRight, xs.end - w, ys.start),
+        (SeriesLabelPosition::LowerLeft, xs.start, ys.start),
+    ];
+    let mut best = (usize::MAX, SeriesLabelPosition::UpperRight);
+    for (position, x0, y0) in corners {
+        let inside = points
+            .iter()
+            .filter(|p| p.0 >= x0 && p.0 <= x0 + w && p.1 >= y0 && p.1 <= y0 + h)
+            .count();
+        if inside < best.0 {
+            best = (inside, position);
+        }
+    }
+    best.1
+}
+
+/// The points of a polyline and the midpoints of its segments (what
+/// [`quiet_corner`] counts for a line).
+pub fn with_midpoints(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    let mut out = points.to_vec();
+    out.extend(
+        points
+            .windows(2)
+            .map(|w| (0.5 * (w[0].0 + w[1].0), 0.5 * (w[0].1 + w[1].1))),
+    );
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_legend_goes_where_the_data_is_not() {
+        let xs = 0.0..1.0;
+        let ys = 0.0..1.0;
+        // Data along the rising diagonal: the upper left and lower right are free.
+        let diagonal: Vec<(f64, f64)> = (0..=10)
+            .map(|k| (k as f64 / 10.0, k as f64 / 10.0))
+            .collect();
+        assert!(matches!(
+            quiet_corner(&diagonal, &xs, &ys),
+            SeriesLabelPosition::UpperLeft
+        ));
+        // Data everywhere but the lower left.
+        let mut busy = diagonal.clone();
+        busy.extend([(0.1, 0.9), (0.2, 0.8), (0.9, 0.1), (0.8, 0.3)]);
+        busy.retain(|p| !(p.0 < 0.5 && p.1 < 0.5));
+        assert!(matches!(
+            quiet_corner(&busy, &xs, &ys),
+            SeriesLabelPosition::LowerLeft
+        ));
+        assert_eq!(with_midpoints(&[(0.0, 0.0), (1.0, 2.0)]).len(), 3);
+    }
+
+    #[test]
+    fn numbers_never_show_minus_zero() {
+        assert_eq!(number(-0.00001), "0");
+        assert_eq!(number(2.50), "2.5");
+        assert_eq!(number(-1.23456), "-1.2346");
+    }
+}

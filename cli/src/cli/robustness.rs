@@ -5,6 +5,7 @@
 use super::ModelArgs;
 use anyhow::{Context, bail};
 use clap::Args;
+use eigenmpc_cli::report::number;
 use eigenmpc_cli::robustness::report::{RunPair, csv, markdown, plot};
 use eigenmpc_cli::robustness::{CATEGORIES, Setup, default_cases, run_case};
 use indicatif::{ParallelProgressIterator, ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -130,8 +131,8 @@ pub fn run(args: &RobustnessArgs) -> anyhow::Result<()> {
     let table = args.out.join("robustness.csv");
     std::fs::write(&table, csv(&rows)).with_context(|| format!("writing {}", table.display()))?;
     let caption = format!(
-        "EigenMPC robustness (curved, {} J): energy error of the last 5 s, o success, x failure",
-        args.energy
+        "EigenMPC robustness (curved, E_ref = {} J): mean energy error of the last 5 s; \u{25cf} success, \u{2715} failure; success share without / with adaptation",
+        number(args.energy)
     );
     for ext in ["png", "svg"] {
         let path = args.out.join(format!("robustness.{ext}"));

@@ -141,6 +141,21 @@ pub fn csv(rows: &[RunPair]) -> String {
     s
 }
 
+/// The x axis label of a parameter in its unit, in symbols.
+fn axis_label(parameter: &str, unit: &str) -> String {
+    let parameter = match parameter {
+        "sigma" => "noise \u{3c3}",
+        "a" => "responsiveness a (u += a (\u{3c4} - u) per sample)",
+        p => p,
+    };
+    match unit {
+        "x nominal" => "factor of the nominal value".to_string(),
+        "" => parameter.to_string(),
+        "kg m^2" => format!("{parameter} (kg m\u{b2})"),
+        unit => format!("{parameter} ({unit})"),
+    }
+}
+
 /// Plots one panel per category: the energy error (%) of the mean over
 /// the last 5 s against the varied quantity, without (blue) and with
 /// (orange) adaptation, one line per parameter; a filled circle is a
@@ -210,26 +225,26 @@ where
             .iter()
             .flat_map(|r| [clip(r.off.energy_error), clip(r.on.energy_error)]);
         let (elo, ehi) = errors.fold((-6.0f64, 6.0f64), |(a, b), v| (a.min(v), b.max(v)));
+        let xs = (lo - pad)..(hi + pad);
+        let ys = (elo * 1.1)..(ehi * 1.1);
+        let mut drawn: Vec<(f64, f64)> = vec![];
         let unit = runs.first().map_or("", |r| r.case.unit);
         let parameter = runs.first().map_or("", |r| r.case.parameter.as_str());
-        let x_desc = match unit {
-            "x nominal" => "factor of the nominal value".to_string(),
-            "" => parameter.to_string(),
-            unit => format!("{parameter} ({unit})"),
-        };
+        let x_desc = axis_label(parameter, unit);
         let mut chart = ChartBuilder::on(panel)
             .caption(
                 format!(
-                    "{category}: {:.0} % / {:.0} % of {n}",
+                    "{category}: {:.0} % / {:.0} % of {n} succeed",
                     100.0 * off,
                     100.0 * on
                 ),
                 ("sans-serif", 17),
             )
             .margin(12)
+            .margin_right(24)
             .x_label_area_size(42)
             .y_label_area_size(52)
-            .build_cartesian_2d((lo - pad)..(hi + pad), (elo * 1.1)..(ehi * 1.1))
+            .build_cartesian_2d(xs.clone(), ys.clone())
             .map_err(err)?;
         chart
             .configure_mesh()
@@ -284,8 +299,10 @@ where
                     },
                     if adapt { "adapt" } else { "no adapt" }
                 );
+                let line: Vec<(f64, f64)> = points.iter().map(|p| (p.0, p.1)).collect();
+                drawn.extend(crate::report::with_midpoints(&line));
                 chart
-                    .draw_series(LineSeries::new(points.iter().map(|p| (p.0, p.1)), style))
+                    .draw_series(LineSeries::new(line, style))
                     .map_err(err)?
                     .label(label)
                     .legend(move |(x, y)| PathElement::new([(x, y), (x + 14, y)], style));
@@ -306,7 +323,7 @@ where
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK.mix(0.3))
             .label_font(("sans-serif", 12))
-            .position(SeriesLabelPosition::UpperRight)
+            .position(crate::report::quiet_corner(&drawn, &xs, &ys))
             .draw()
             .map_err(err)?;
     }
