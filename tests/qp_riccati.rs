@@ -438,3 +438,108 @@ fn warm_start_from_an_unrelated_solution_still_converges_to_the_same_point() {
         );
     }
 }
+
+#[test]
+fn inactive_start_gives_the_interior_point_solution() {
+    // RTI on an eigenmode: the bounds are far. The inactive-set start
+    // solves such QPs in one Riccati step, exactly where the interior point
+    // (the setting off) ends with no active bound, and gives the same point
+    // as it and clarabel; with an active bound it falls back to the
+    // interior point.
+    let mut rng = SplitMix64::new(91);
+    let plain = RiccatiSettings {
+        inactive_start: false,
+        ..RiccatiSettings::default()
+    };
+    let mut cases: Vec<OcpQp> = vec![];
+    for _ in 0..4 {
+        cases.push(with_control_box(random_ocp_qp(&mut rng, 4, 2, 80), 10.0));
+        cases.push(with_control_box(random_ocp_qp(&mut rng, 4, 2, 80), 0.2));
+        cases.push(with_control_box(random_ocp_qp(&mut rng, 6, 3, 40), 10.0));
+        cases.push(with_control_box(random_ocp_qp(&mut rng, 2, 1, 40), 10.0));
+    }
+    for tau_max in [1.0, 5.0, 50.0] {
+        let pendulum = PendulumQpOptions {
+            tau_max,
+            initial_deviation: 0.01,
+            velocity_bound: f64::INFINITY,
+            ..Default::default()
+        };
+        for _ in 0..4 {
+            cases.push(pendulum_rti_qp(&mut rng, &pendulum));
+        }
+    }
+    let (mut one_step_count, mut active_count) = (0, 0);
+    for (i, qp) in cases.iter().enumerate() {
+        let (sol, solver) = solve(qp);
+        let mut reference_solver = RiccatiSolver::new(qp.nx, qp.nu, qp.horizon, plain);
+        let mut ip = QpSolution::new(qp.nx, qp.nu, qp.horizon);
+        assert_eq!(reference_solver.solve(qp, &mut ip), QpStatus::Solved);
+        let largest_multiplier = ip
+            .lam_u_lower
+            .iter()
+            .chain(&ip.lam_u_upper)
+            .map(|l| l.amax())
+            .fold(0.0, f64::max);
+        let active = largest_multiplier > 1e-6;
+        let what = format!("case {i} (largest multiplier {largest_multiplier:.1e})");
+        assert_matches(&what, qp, &sol, &clarabel_solve(qp));
+        let du = (0..qp.horizon)
+            .map(|k| (&sol.u[k] - &ip.u[k]).amax())
+            .fold(0.0, f64::max);
+        assert!(
+            du < 1e-8,
+            "{what}: controls differ from the interior point's by {du:e}"
+        );
+        let one_step = solver.info().iterations == 1;
+        assert_eq!(
+            one_step,
+            !active,
+            "{what}: {} iterations",
+            solver.info().iterations
+        );
+        if one_step {
+            one_step_count += 1;
+            // Multipliers of an inactive solution are exactly zero.
+            assert!(
+                sol.lam_u_lower
+                    .iter()
+                    .chain(&sol.lam_u_upper)
+                    .all(|l| l.amax() == 0.0)
+            );
+        } else {
+            active_count += 1;
+        }
+    }
+    assert!(
+        one_step_count >= 12 && active_count >= 4,
+        "{one_step_count} / {active_count}"
+    );
+}
+
+#[test]
+fn inactive_start_is_skipped_after_an_active_solution_and_taken_again_later() {
+    let mut rng = SplitMix64::new(92);
+    let n = 40;
+    let tight = with_control_box(random_ocp_qp(&mut rng, 4, 2, n), 0.2);
+    let loose = with_control_box(random_ocp_qp(&mut rng, 4, 2, n), 50.0);
+    let mut solver = RiccatiSolver::new(4, 2, n, RiccatiSettings::default());
+    let mut sol = QpSolution::new(4, 2, n);
+    assert_eq!(solver.solve(&tight, &mut sol), QpStatus::Solved);
+    assert!(solver.info().iterations > 1);
+    // The shifted multipliers say a bound was active: no one-step attempt.
+    solver.shift_warm_start(true);
+    assert_eq!(solver.solve(&loose, &mut sol), QpStatus::Solved);
+    assert!(solver.info().iterations > 1);
+    assert_matches(
+        "after the active solve",
+        &loose,
+        &sol,
+        &clarabel_solve(&loose),
+    );
+    // Its solution has no active bound: the next one is tried and taken.
+    solver.shift_warm_start(true);
+    assert_eq!(solver.solve(&loose, &mut sol), QpStatus::Solved);
+    assert_eq!(solver.info().iterations, 1);
+    assert_matches("inactive-set start", &loose, &sol, &clarabel_solve(&loose));
+}

@@ -13,7 +13,7 @@
 use eigenmpc::adapt::{AdaptOptions, Adaptation};
 use eigenmpc::mechanics::{DoublePendulum, PlanarChain, PlanarChainParams};
 use eigenmpc::modes::{ChartFamily, FamilyOptions};
-use eigenmpc::mpc::closed_loop::{Sample, quantile, reference_for, run};
+use eigenmpc::mpc::closed_loop::{Sample, mode_and_chart, quantile, reference_for, run};
 use eigenmpc::mpc::{Controller, MpcConfig, QpBackend, Variant};
 use eigenmpc::robustness::{Imperfections, run_imperfect};
 use nalgebra::SVector;
@@ -38,7 +38,25 @@ fn ms(x: [f64; 4]) -> String {
     )
 }
 
+/// Where a closed loop starts: the paper's near-rest start, or on the
+/// 14 J in-phase eigenmode (its turning point at rest: the steady state).
+#[derive(Clone, Copy, PartialEq)]
+enum Start {
+    Rest,
+    Orbit,
+}
+
 fn run_case(
+    variant: Variant,
+    horizon: usize,
+    duration: f64,
+    backend: QpBackend,
+) -> Vec<Sample<2, 4>> {
+    run_from(Start::Rest, variant, horizon, duration, backend)
+}
+
+fn run_from(
+    start: Start,
     variant: Variant,
     horizon: usize,
     duration: f64,
@@ -51,8 +69,27 @@ fn run_case(
     config.qp = backend;
     // Keep the simulated dynamics identical across N: same sample period.
     let mut ctrl = Controller::<_, 2, 4>::new(sys, config, reference).expect("controller");
-    let z0 = SVector::<f64, 4>::new(0.05, 0.05, 0.0, 0.0);
+    let z0 = match start {
+        Start::Rest => SVector::<f64, 4>::new(0.05, 0.05, 0.0, 0.0),
+        Start::Orbit => {
+            let (mode, _) = mode_and_chart::<_, 2, 4>(&sys, 0, 14.0, 9).expect("14 J mode");
+            SVector::<f64, 4>::new(mode.turning_point[0], mode.turning_point[1], 0.0, 0.0)
+        }
+    };
     run(&mut ctrl, &sys, &z0, duration).expect("closed loop")
+}
+
+/// The CPU's model name (Linux), for the tables' headings.
+fn cpu() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| {
+            t.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split_once(':'))
+                .map(|(_, v)| v.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown CPU".into())
 }
 
 fn main() {
@@ -72,12 +109,42 @@ fn main() {
         "## EigenMPC control step, N = 80, dt = 25 ms, {duration} s closed loop, both QP backends\n"
     );
     println!(
-        "| scenario | QP | phase | median ms | p95 ms | p99 ms | max ms | QP iter. median / max |"
+        "Measured on {} ({} threads). The ratio column divides the sample median by clarabel's in the same run (same process, same machine state): it moves less between machines than the times.\n",
+        cpu(),
+        std::thread::available_parallelism().map_or(1, |n| n.get())
     );
-    println!("|---|---|---|---|---|---|---|---|");
-    for variant in [Variant::Curved, Variant::Straight] {
-        for backend in QpBackend::ALL {
-            let trace = run_case(variant, 80, duration, backend);
+    println!(
+        "| scenario | QP | phase | median ms | p95 ms | p99 ms | max ms | QP iter. median / max | sample median / clarabel's |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|");
+    for (start, variant, name) in [
+        (
+            Start::Rest,
+            Variant::Curved,
+            "curved 14 J in-phase, from rest",
+        ),
+        (
+            Start::Rest,
+            Variant::Straight,
+            "straight 14 J in-phase, from rest",
+        ),
+        (
+            Start::Orbit,
+            Variant::Curved,
+            "curved 14 J in-phase, on the orbit",
+        ),
+    ] {
+        let traces: Vec<(QpBackend, Vec<Sample<2, 4>>)> = QpBackend::ALL
+            .into_iter()
+            .map(|b| (b, run_from(start, variant, 80, duration, b)))
+            .collect();
+        let median_total =
+            |trace: &[Sample<2, 4>]| stats(trace[1..].iter().map(|s| s.solve_time).collect())[0];
+        let clarabel = traces
+            .iter()
+            .find(|(b, _)| *b == QpBackend::Clarabel)
+            .map_or(f64::NAN, |(_, t)| median_total(t));
+        for (backend, trace) in &traces {
             let rest = &trace[1..];
             let prep: Vec<f64> = rest.iter().map(|s| s.preparation_time).collect();
             let feedback: Vec<f64> = rest
@@ -87,20 +154,23 @@ fn main() {
             let total: Vec<f64> = rest.iter().map(|s| s.solve_time).collect();
             let iters = stats(rest.iter().map(|s| s.qp_iterations as f64).collect());
             let failures = rest.iter().filter(|s| !s.status.is_ok()).count();
-            let name = format!("{variant} 14 J in-phase");
             println!(
-                "| {name} | {backend} | preparation | {} | |",
+                "| {name} | {backend} | preparation | {} | | |",
                 ms(stats(prep))
             );
             println!(
-                "| {name} | {backend} | feedback (QP) | {} | {:.0} / {:.0} |",
+                "| {name} | {backend} | feedback (QP) | {} | {:.0} / {:.0} | |",
                 ms(stats(feedback)),
                 iters[0],
                 iters[3]
             );
-            println!("| {name} | {backend} | total | {} | |", ms(stats(total)));
             println!(
-                "| {name} | {backend} | first sample (converged SQP, cold start) | {:.3} | | | | {failures} failed samples |",
+                "| {name} | {backend} | total | {} | | {:.3} |",
+                ms(stats(total)),
+                median_total(trace) / clarabel
+            );
+            println!(
+                "| {name} | {backend} | first sample (converged SQP, cold start) | {:.3} | | | | {failures} failed samples | |",
                 trace[0].solve_time * 1e3
             );
         }

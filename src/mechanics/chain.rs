@@ -448,8 +448,7 @@ impl<const N: usize> PlanarChain<N> {
 
     /// Inertia in absolute angles `Mt(phi)`, rotors included.
     fn absolute_mass_matrix(&self, phi: &Vector<N>) -> Matrix<N> {
-        Matrix::<N>::from_fn(|j, l| self.coupling[(j, l)] * (phi[j] - phi[l]).cos())
-            + self.rotor_absolute
+        self.coupling.component_mul(&relative_sin_cos(phi).1) + self.rotor_absolute
     }
 
     /// Centrifugal forces in absolute angles `h_j = sum_l a_jl sin(phi_j - phi_l) phid_l^2`.
@@ -493,7 +492,7 @@ impl<const N: usize> MechanicalSystem<N> for PlanarChain<N> {
     fn mass_matrix(&self, q: &Vector<N>) -> Matrix<N> {
         let phi = Self::absolute(q);
         let l = Self::l_matrix();
-        let links = Matrix::<N>::from_fn(|j, m| self.coupling[(j, m)] * (phi[j] - phi[m]).cos());
+        let links = self.coupling.component_mul(&relative_sin_cos(&phi).1);
         l.transpose() * links * l + self.rotor_joint
     }
 
@@ -576,15 +575,19 @@ impl<const N: usize> MechanicalSystem<N> for PlanarChain<N> {
         let phi = Self::absolute(q);
         let phid = Self::absolute(qd);
         let a = &self.coupling;
-        let sin = Matrix::<N>::from_fn(|j, l| (phi[j] - phi[l]).sin());
-        let cos = Matrix::<N>::from_fn(|j, l| (phi[j] - phi[l]).cos());
+        let (sin, cos) = relative_sin_cos(&phi);
         let a_cos = a.component_mul(&cos);
         let a_sin = a.component_mul(&sin);
         let mt = a_cos + self.rotor_absolute;
 
         let joint = tau - self.spring_forces(q);
         let centrifugal = a_sin * phid.component_mul(&phid);
-        let gravity = Vector::<N>::from_fn(|j, _| self.gravity_amplitude[j] * phi[j].sin());
+        let mut sin_phi = Vector::<N>::zeros();
+        let mut cos_phi = Vector::<N>::zeros();
+        for j in 0..N {
+            (sin_phi[j], cos_phi[j]) = phi[j].sin_cos();
+        }
+        let gravity = self.gravity_amplitude.component_mul(&sin_phi);
         let w = Self::to_absolute_forces(&joint) - centrifugal - gravity;
 
         let chol = mt.cholesky();
@@ -612,9 +615,7 @@ impl<const N: usize> MechanicalSystem<N> for PlanarChain<N> {
             diag - a_cos[(j, k)] * phid_sq[k]
         });
         let d_cent_phid = Matrix::<N>::from_fn(|j, k| 2.0 * a_sin[(j, k)] * phid[k]);
-        let d_grav = Matrix::<N>::from_diagonal(&Vector::<N>::from_fn(|j, _| {
-            self.gravity_amplitude[j] * phi[j].cos()
-        }));
+        let d_grav = Matrix::<N>::from_diagonal(&self.gravity_amplitude.component_mul(&cos_phi));
 
         let l = Self::l_matrix();
         let l_inv = Self::l_inverse();
@@ -635,7 +636,7 @@ impl<const N: usize> MechanicalSystem<N> for PlanarChain<N> {
     fn energy_gradient(&self, q: &Vector<N>, qd: &Vector<N>) -> (Vector<N>, Vector<N>) {
         let phi = Self::absolute(q);
         let phid = Self::absolute(qd);
-        let a_sin = Matrix::<N>::from_fn(|j, l| self.coupling[(j, l)] * (phi[j] - phi[l]).sin());
+        let a_sin = self.coupling.component_mul(&relative_sin_cos(&phi).0);
         // dT/dphi_k = -phid_k sum_l a_kl s_kl phid_l
         let d_kinetic = -phid.component_mul(&(a_sin * phid));
         let d_e_dq = Self::to_joint_forces(&d_kinetic) + self.potential_gradient(q);
@@ -644,9 +645,40 @@ impl<const N: usize> MechanicalSystem<N> for PlanarChain<N> {
     }
 }
 
+/// `sin(phi_j - phi_l)` and `cos(phi_j - phi_l)` for all pairs: one
+/// sine-cosine pair per `j < l` (antisymmetric and symmetric, 0 and 1 on
+/// the diagonal, exactly as the direct formulas give them).
+#[inline]
+fn relative_sin_cos<const N: usize>(phi: &Vector<N>) -> (Matrix<N>, Matrix<N>) {
+    let mut sin = Matrix::<N>::zeros();
+    let mut cos = Matrix::<N>::identity();
+    for j in 0..N {
+        for l in j + 1..N {
+            let (s, c) = (phi[j] - phi[l]).sin_cos();
+            sin[(j, l)] = s;
+            sin[(l, j)] = -s;
+            cos[(j, l)] = c;
+            cos[(l, j)] = c;
+        }
+    }
+    (sin, cos)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn relative_trigonometry_equals_the_direct_formulas() {
+        let phi = Vector::<3>::new(0.3, -1.7, 2.9);
+        let (sin, cos) = relative_sin_cos(&phi);
+        for j in 0..3 {
+            for l in 0..3 {
+                assert_eq!(sin[(j, l)], (phi[j] - phi[l]).sin());
+                assert_eq!(cos[(j, l)], (phi[j] - phi[l]).cos());
+            }
+        }
+    }
 
     fn pendulum() -> DoublePendulum {
         DoublePendulum::default()

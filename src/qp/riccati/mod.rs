@@ -80,6 +80,15 @@ pub struct RiccatiSettings {
     /// solution sits on the boundary (products ~1e-11), where the Newton
     /// steps would be cut to nothing; 1e-2 measured best of 1e-1..1e-4.
     pub warm_start_floor: f64,
+    /// Before the interior point, try the QP without its inequalities when
+    /// none was active in the previous solution: one Riccati factorisation
+    /// and solve give the exact equality-constrained optimum, which is the
+    /// QP's optimum (all multipliers zero) when it satisfies every bound
+    /// strictly. RTI on an eigenmode runs torque-free, far from the bounds,
+    /// so most samples need no interior-point iteration (issue 12). Only
+    /// the compile-time-sized cores (1-3 joints) without soft state bounds
+    /// take this path.
+    pub inactive_start: bool,
 }
 
 impl Default for RiccatiSettings {
@@ -99,6 +108,7 @@ impl Default for RiccatiSettings {
             mehrotra_start: true,
             warm_start: true,
             warm_start_floor: 1e-2,
+            inactive_start: true,
         }
     }
 }
@@ -335,35 +345,32 @@ impl RiccatiSolver {
                     core.info,
                 )
             }
-            Engine::Joints1(core) => {
-                core.load(qp, set);
-                core.warm = self.warm_next;
-                (
-                    interior_point(&mut **core, set, self.warm_next, sol),
-                    core.info,
-                )
-            }
-            Engine::Joints2(core) => {
-                core.load(qp, set);
-                core.warm = self.warm_next;
-                (
-                    interior_point(&mut **core, set, self.warm_next, sol),
-                    core.info,
-                )
-            }
-            Engine::Joints3(core) => {
-                core.load(qp, set);
-                core.warm = self.warm_next;
-                (
-                    interior_point(&mut **core, set, self.warm_next, sol),
-                    core.info,
-                )
-            }
+            Engine::Joints1(core) => run_fixed(core, qp, set, self.warm_next, sol),
+            Engine::Joints2(core) => run_fixed(core, qp, set, self.warm_next, sol),
+            Engine::Joints3(core) => run_fixed(core, qp, set, self.warm_next, sol),
         };
         self.info = info;
         self.total_regularised += self.info.regularised_pivots as u64;
         status
     }
+}
+
+/// One solve on a compile-time-sized core: the inactive-set start when it
+/// applies, the interior point otherwise.
+fn run_fixed<const NX: usize, const NU: usize, const M: usize>(
+    core: &mut FixedCore<NX, NU, M>,
+    qp: &OcpQp,
+    set: &RiccatiSettings,
+    warm: bool,
+    sol: &mut QpSolution,
+) -> (QpStatus, RiccatiInfo) {
+    core.load(qp, set);
+    core.warm = warm;
+    let status = match core.solve_inactive(sol) {
+        Some(status) => status,
+        None => interior_point(core, set, warm, sol),
+    };
+    (status, core.info)
 }
 
 impl QpSolver for RiccatiSolver {

@@ -1,0 +1,69 @@
+#!/usr/bin/env bash
+# Regenerates docs/speed.md (README "Speed"): the per-sample times of
+# `bench_mpc` with the CPU they were measured on and same-run ratios, and the
+# instruction counts per RTI sample (callgrind), which do not depend on the
+# machine. `bash scripts/bench.sh [OUT]` (default docs/speed.md); installs
+# valgrind with apt when it is missing and you are root.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+out=${1:-docs/speed.md}
+source scripts/ensure-build-deps.sh
+if ! command -v valgrind >/dev/null 2>&1; then
+    apt_install valgrind
+fi
+cargo build --release --bin bench_mpc --example rti_profile
+target_dir=${CARGO_TARGET_DIR:-target}
+profile="$target_dir/release/examples/rti_profile"
+cpu=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')
+cores=$(nproc)
+mhz=$(grep -m1 'cpu MHz' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//' || true)
+flags=$(grep -m1 '^flags' /proc/cpuinfo | tr ' ' '\n' | grep -E '^(avx2|fma|avx512f)$' | tr '\n' ' ' || true)
+
+# Instructions of Controller::step, of its linearisation and of its QP solve
+# per sample: two run lengths subtracted, so the first sample (converged SQP
+# from a cold start) drops out.
+count() { # start seconds qp variant -> "step linearise qp" (inclusive Ir)
+    local file
+    file=$(mktemp)
+    valgrind --tool=callgrind --callgrind-out-file="$file" \
+        --toggle-collect='*Controller*step*' "$profile" "$@" >/dev/null 2>&1
+    callgrind_annotate --inclusive=yes "$file" 2>/dev/null | awk '
+        function n(s) { gsub(",", "", s); return s + 0 }
+        /Controller<S,_,_>::step \[/ && !step { step = n($1) }
+        /Controller<S,_,_>>::linearise \[/ && !lin { lin = n($1) }
+        /as eigenmpc::qp::QpSolver>::solve \[/ && !qp { qp = n($1) }
+        END { print step, lin, qp }'
+    rm -f "$file"
+}
+per_sample() { # start qp variant
+    local a b
+    a=($(count "$1" 10 "$2" "$3"))
+    b=($(count "$1" 20 "$2" "$3"))
+    # 400 samples between 10 s and 20 s at 25 ms.
+    awk -v s1="${a[0]}" -v s2="${b[0]}" -v l1="${a[1]}" -v l2="${b[1]}" \
+        -v q1="${a[2]}" -v q2="${b[2]}" 'BEGIN {
+        printf "%.0f | %.0f | %.0f", (s2 - s1) / 400 / 1000, (l2 - l1) / 400 / 1000, (q2 - q1) / 400 / 1000 }'
+}
+
+{
+    echo "# Speed of the EigenMPC control step"
+    echo
+    echo "Regenerate: \`bash scripts/bench.sh\` (this file). Measured on **${cpu}** (${cores} cores${mhz:+, ${mhz} MHz}; ${flags:-no AVX2/FMA}), $(rustc --version), release build, default target (x86-64 baseline, no \`target-cpu\`), $(date -u +%Y-%m-%d)."
+    echo
+    echo "## Instructions per sample (callgrind; the same on every x86-64 machine for this build)"
+    echo
+    echo "Paper set-up (N = 80, dt = 25 ms, 2 links), thousands of instructions per RTI sample, averaged over the 400 samples from 10 s to 20 s. \`rest\`: the paper's start at q = (0.05, 0.05), so 10-20 s is the torque-limited climb (the interior point works in most samples); \`orbit\`: from the 14 J in-phase eigenmode's turning point, on the orbit throughout (the steady state)."
+    echo
+    echo "| start | variant | QP | step (k instr.) | linearisation (k instr.) | QP solve (k instr.) |"
+    echo "|---|---|---|---|---|---|"
+    for start in orbit rest; do
+        for variant in curved straight; do
+            echo "| $start | $variant | riccati | $(per_sample $start riccati $variant) |"
+        done
+    done
+    echo "| orbit | curved | clarabel | $(per_sample orbit clarabel curved) |"
+    echo
+    "$target_dir/release/bench_mpc"
+} > "$out.tmp"
+mv "$out.tmp" "$out"
+echo "wrote $out"
