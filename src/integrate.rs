@@ -2,7 +2,10 @@
 //! shooting map) and adaptive Dormand-Prince 5(4) (the plant and the orbit
 //! computations).
 
-use crate::mechanics::{MechanicalSystem, Vector, state_derivative, state_jacobian};
+use crate::mechanics::{
+    DynamicsJacobian, MechanicalSystem, Vector, pack_state, state_derivative, state_jacobian,
+    unpack_state,
+};
 use nalgebra::{SMatrix, SVector};
 use std::ops::{Add, Mul};
 use thiserror::Error;
@@ -139,25 +142,35 @@ pub fn rk4_step_sensitivity<S, const N: usize, const NX: usize>(
 where
     S: MechanicalSystem<N> + ?Sized,
 {
+    // A stage's Jacobian is [0 I; Dq Dqd] (and [0; Dtau] for the torque):
+    // products with it take the lower block rows only, half of a dense
+    // product (issue 12).
     let eye = SMatrix::<f64, NX, NX>::identity();
-    let (k1, a1, b1) = state_jacobian::<S, N, NX>(system, z, tau);
-    let dk1_z = a1;
-    let dk1_u = b1;
+    let stage = |x: &SVector<f64, NX>| {
+        let (q, qd) = unpack_state::<N, NX>(x);
+        let jac = system.dynamics_jacobian(&q, &qd, tau);
+        (pack_state::<N, NX>(&qd, &jac.acceleration), jac)
+    };
+    let (k1, j1) = stage(z);
+    let (dk1_z, dk1_u) = (
+        jacobian_times::<N, NX, NX>(&j1, &eye),
+        torque_column::<N, NX>(&j1),
+    );
 
     let z2 = z + k1 * (0.5 * h);
-    let (k2, a2, b2) = state_jacobian::<S, N, NX>(system, &z2, tau);
-    let dk2_z = a2 * (eye + dk1_z * (0.5 * h));
-    let dk2_u = a2 * dk1_u * (0.5 * h) + b2;
+    let (k2, j2) = stage(&z2);
+    let dk2_z = jacobian_times::<N, NX, NX>(&j2, &(eye + dk1_z * (0.5 * h)));
+    let dk2_u = jacobian_times::<N, NX, N>(&j2, &(dk1_u * (0.5 * h))) + torque_column::<N, NX>(&j2);
 
     let z3 = z + k2 * (0.5 * h);
-    let (k3, a3, b3) = state_jacobian::<S, N, NX>(system, &z3, tau);
-    let dk3_z = a3 * (eye + dk2_z * (0.5 * h));
-    let dk3_u = a3 * dk2_u * (0.5 * h) + b3;
+    let (k3, j3) = stage(&z3);
+    let dk3_z = jacobian_times::<N, NX, NX>(&j3, &(eye + dk2_z * (0.5 * h)));
+    let dk3_u = jacobian_times::<N, NX, N>(&j3, &(dk2_u * (0.5 * h))) + torque_column::<N, NX>(&j3);
 
     let z4 = z + k3 * h;
-    let (k4, a4, b4) = state_jacobian::<S, N, NX>(system, &z4, tau);
-    let dk4_z = a4 * (eye + dk3_z * h);
-    let dk4_u = a4 * dk3_u * h + b4;
+    let (k4, j4) = stage(&z4);
+    let dk4_z = jacobian_times::<N, NX, NX>(&j4, &(eye + dk3_z * h));
+    let dk4_u = jacobian_times::<N, NX, N>(&j4, &(dk3_u * h)) + torque_column::<N, NX>(&j4);
 
     let w = h / 6.0;
     Rk4Sensitivity {
@@ -165,6 +178,31 @@ where
         d_z: eye + (dk1_z + (dk2_z + dk3_z) * 2.0 + dk4_z) * w,
         d_tau: (dk1_u + (dk2_u + dk3_u) * 2.0 + dk4_u) * w,
     }
+}
+
+/// `[0 I; Dq Dqd] x`: the state Jacobian of the first-order dynamics times `x`.
+#[inline(always)]
+fn jacobian_times<const N: usize, const NX: usize, const C: usize>(
+    jac: &DynamicsJacobian<N>,
+    x: &SMatrix<f64, NX, C>,
+) -> SMatrix<f64, NX, C> {
+    let top = x.fixed_rows::<N>(0);
+    let bottom = x.fixed_rows::<N>(N);
+    let mut out = SMatrix::<f64, NX, C>::zeros();
+    out.fixed_rows_mut::<N>(0).copy_from(&bottom);
+    out.fixed_rows_mut::<N>(N)
+        .copy_from(&(jac.d_q * top + jac.d_qd * bottom));
+    out
+}
+
+/// `[0; Dtau]`: the torque Jacobian of the first-order dynamics.
+#[inline(always)]
+fn torque_column<const N: usize, const NX: usize>(
+    jac: &DynamicsJacobian<N>,
+) -> SMatrix<f64, NX, N> {
+    let mut out = SMatrix::<f64, NX, N>::zeros();
+    out.fixed_rows_mut::<N>(N).copy_from(&jac.d_tau);
+    out
 }
 
 /// Tolerances of the adaptive integrator.
