@@ -575,28 +575,7 @@ impl<const N: usize> MechanicalSystem<N> for PlanarChain<N> {
         let phi = Self::absolute(q);
         let phid = Self::absolute(qd);
         let a = &self.coupling;
-        // N sine-cosine pairs of the absolute angles give the relative ones
-        // by the difference formulas (libm's sin and cos were 12 % of an RTI
-        // sample on the orbit, issue 12).
-        let mut sin_phi = Vector::<N>::zeros();
-        let mut cos_phi = Vector::<N>::zeros();
-        for j in 0..N {
-            (sin_phi[j], cos_phi[j]) = phi[j].sin_cos();
-        }
-        let sin = Matrix::<N>::from_fn(|j, l| {
-            if j == l {
-                0.0
-            } else {
-                sin_phi[j] * cos_phi[l] - cos_phi[j] * sin_phi[l]
-            }
-        });
-        let cos = Matrix::<N>::from_fn(|j, l| {
-            if j == l {
-                1.0
-            } else {
-                cos_phi[j] * cos_phi[l] + sin_phi[j] * sin_phi[l]
-            }
-        });
+        let (sin_phi, cos_phi, sin, cos) = trigonometry(&phi);
         let a_cos = a.component_mul(&cos);
         let a_sin = a.component_mul(&sin);
         let mt = a_cos + self.rotor_absolute;
@@ -661,6 +640,32 @@ impl<const N: usize> MechanicalSystem<N> for PlanarChain<N> {
     }
 }
 
+/// `sin phi_j`, `cos phi_j` and the relative `sin(phi_j - phi_l)`,
+/// `cos(phi_j - phi_l)` from N libm sine-cosine pairs: the relative ones by
+/// the difference formulas (to a few ulps of the direct values). The libm
+/// calls were 12 % of an RTI sample on the orbit (issue 12).
+#[inline]
+fn trigonometry<const N: usize>(phi: &Vector<N>) -> (Vector<N>, Vector<N>, Matrix<N>, Matrix<N>) {
+    let mut sin_phi = Vector::<N>::zeros();
+    let mut cos_phi = Vector::<N>::zeros();
+    for j in 0..N {
+        (sin_phi[j], cos_phi[j]) = phi[j].sin_cos();
+    }
+    let mut sin = Matrix::<N>::zeros();
+    let mut cos = Matrix::<N>::identity();
+    for j in 0..N {
+        for l in j + 1..N {
+            let s = sin_phi[j] * cos_phi[l] - cos_phi[j] * sin_phi[l];
+            let c = cos_phi[j] * cos_phi[l] + sin_phi[j] * sin_phi[l];
+            sin[(j, l)] = s;
+            sin[(l, j)] = -s;
+            cos[(j, l)] = c;
+            cos[(l, j)] = c;
+        }
+    }
+    (sin_phi, cos_phi, sin, cos)
+}
+
 /// `sin(phi_j - phi_l)` and `cos(phi_j - phi_l)` for all pairs: one
 /// sine-cosine pair per `j < l` (antisymmetric and symmetric, 0 and 1 on
 /// the diagonal, exactly as the direct formulas give them).
@@ -687,32 +692,25 @@ mod tests {
     #[test]
     fn relative_trigonometry_equals_the_direct_formulas() {
         let phi = Vector::<3>::new(0.3, -1.7, 2.9);
-        // N sine-cosine pairs of the absolute angles give the relative ones
-        // by the difference formulas (libm's sin and cos were 12 % of an RTI
-        // sample on the orbit, issue 12).
-        let mut sin_phi = Vector::<N>::zeros();
-        let mut cos_phi = Vector::<N>::zeros();
-        for j in 0..N {
-            (sin_phi[j], cos_phi[j]) = phi[j].sin_cos();
-        }
-        let sin = Matrix::<N>::from_fn(|j, l| {
-            if j == l {
-                0.0
-            } else {
-                sin_phi[j] * cos_phi[l] - cos_phi[j] * sin_phi[l]
-            }
-        });
-        let cos = Matrix::<N>::from_fn(|j, l| {
-            if j == l {
-                1.0
-            } else {
-                cos_phi[j] * cos_phi[l] + sin_phi[j] * sin_phi[l]
-            }
-        });
+        let (sin, cos) = relative_sin_cos(&phi);
         for j in 0..3 {
             for l in 0..3 {
                 assert_eq!(sin[(j, l)], (phi[j] - phi[l]).sin());
                 assert_eq!(cos[(j, l)], (phi[j] - phi[l]).cos());
+            }
+        }
+    }
+
+    #[test]
+    fn trigonometry_from_absolute_angles_matches_the_direct_formulas() {
+        let phi = Vector::<3>::new(0.3, -1.7, 2.9);
+        let (sin_phi, cos_phi, sin, cos) = trigonometry(&phi);
+        for j in 0..3 {
+            assert_eq!(sin_phi[j], phi[j].sin());
+            assert_eq!(cos_phi[j], phi[j].cos());
+            for l in 0..3 {
+                assert!((sin[(j, l)] - (phi[j] - phi[l]).sin()).abs() < 4.0 * f64::EPSILON);
+                assert!((cos[(j, l)] - (phi[j] - phi[l]).cos()).abs() < 4.0 * f64::EPSILON);
             }
         }
     }
