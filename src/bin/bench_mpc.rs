@@ -202,7 +202,69 @@ fn main() {
             );
         }
     }
+    three_link_table(duration.max(40.0));
     adaptation_table(duration.max(60.0));
+}
+
+/// The 3-link point-mass chain (1 kg, 1 m), curved on its in-phase family
+/// at 20 J, N = 80: from rest, and on the orbit (the mode's turning point).
+fn three_link_table(duration: f64) {
+    println!(
+        "\n## Three links (curved, in-phase family, E_ref = 20 J, N = 80, {duration} s; on {})\n",
+        cpu()
+    );
+    println!(
+        "| start | QP | median ms | p95 ms | p99 ms | max ms | QP iter. median / max | sample median / clarabel's |"
+    );
+    println!("|---|---|---|---|---|---|---|---|");
+    let sys = PlanarChain::<3>::default();
+    let family = ChartFamily::compute::<_, 6>(&sys, 0, &FamilyOptions::up_to(25.0))
+        .expect("3-link in-phase family");
+    let (mode, _) = mode_and_chart::<_, 3, 6>(&sys, 0, 20.0, 9).expect("20 J mode");
+    for (name, z0) in [
+        (
+            "rest",
+            SVector::<f64, 6>::new(0.05, 0.05, 0.05, 0.0, 0.0, 0.0),
+        ),
+        (
+            "orbit",
+            SVector::<f64, 6>::new(
+                mode.turning_point[0],
+                mode.turning_point[1],
+                mode.turning_point[2],
+                0.0,
+                0.0,
+                0.0,
+            ),
+        ),
+    ] {
+        let mut rows = vec![];
+        for backend in QpBackend::ALL {
+            let mut config = MpcConfig::paper(Variant::Curved);
+            config.cost.e_ref = 20.0;
+            config.qp = backend;
+            let mut ctrl = Controller::<_, 3, 6>::with_family(sys, config, family.clone())
+                .expect("controller");
+            let trace = run(&mut ctrl, &sys, &z0, duration).expect("closed loop");
+            let rest = &trace[1..];
+            let total = stats(rest.iter().map(|s| s.solve_time).collect());
+            let iters = stats(rest.iter().map(|s| s.qp_iterations as f64).collect());
+            rows.push((backend, total, iters));
+        }
+        let clarabel = rows
+            .iter()
+            .find(|r| r.0 == QpBackend::Clarabel)
+            .map_or(f64::NAN, |r| r.1[0]);
+        for (backend, total, iters) in rows {
+            println!(
+                "| {name} | {backend} | {} | {:.0} / {:.0} | {:.3} |",
+                ms(total),
+                iters[0],
+                iters[3],
+                total[0] / clarabel
+            );
+        }
+    }
 }
 
 /// The robustness issue's plant (m2 +20 %, l1 +10 %, 0.05 N m s damping)
