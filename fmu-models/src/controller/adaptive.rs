@@ -107,15 +107,26 @@ impl<const N: usize, const NX: usize, const NP: usize> AdaptiveController<N, NX,
 
     /// Continues from `state`, saved by a controller built from the same
     /// settings.
+    /// A refused state changes nothing: the controller part is restored
+    /// first (it checks everything before it changes anything), and put
+    /// back when the adaptation part is refused.
     pub fn restore_state(&mut self, state: AdaptiveState<N, NX, NP>) -> Result<(), String> {
-        match (&mut self.adaptation, state.adaptation) {
-            (Some(a), Some(saved)) => a.restore_state(saved).map_err(|e| e.to_string())?,
-            (None, None) => {}
-            _ => return Err("the saved state has another adapt setting".into()),
+        if self.adaptation.is_some() != state.adaptation.is_some() {
+            return Err("the saved state has another adapt setting".into());
         }
+        let before = self.adaptation.as_ref().map(|_| self.controller.save_state());
         self.controller
             .restore_state(state.controller)
             .map_err(|e| e.to_string())?;
+        if let (Some(a), Some(saved)) = (&mut self.adaptation, state.adaptation)
+            && let Err(e) = a.restore_state(saved)
+        {
+            if let Some(before) = before {
+                // The state was this controller's a moment ago.
+                let _ = self.controller.restore_state(before);
+            }
+            return Err(e.to_string());
+        }
         self.tau = state.tau;
         Ok(())
     }
