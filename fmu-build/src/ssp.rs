@@ -74,6 +74,34 @@ fn parameter_bindings(out: &mut String, values: &[(String, f64)]) {
     out.push_str("        </ssd:ParameterBindings>\n");
 }
 
+/// One `<ssd:Component>`: its FMU, connectors (inputs, outputs, then the
+/// energy output both FMUs have) and start-value bindings.
+fn component(
+    s: &mut String,
+    name: &str,
+    fmu: &str,
+    inputs: &[String],
+    outputs: &[String],
+    bindings: &[(String, f64)],
+) {
+    writeln!(
+        s,
+        r#"      <ssd:Component name="{name}" type="application/x-fmu-sharedlibrary" source="resources/{fmu}.fmu">"#
+    )
+    .unwrap();
+    s.push_str("        <ssd:Connectors>\n");
+    for n in inputs {
+        connector(s, n, "input");
+    }
+    for n in outputs {
+        connector(s, n, "output");
+    }
+    connector(s, "energy", "output");
+    s.push_str("        </ssd:Connectors>\n");
+    parameter_bindings(s, bindings);
+    s.push_str("      </ssd:Component>\n");
+}
+
 /// `SystemStructure.ssd` of `spec`.
 pub fn system_structure(spec: &SspSpec) -> String {
     let joints: Vec<usize> = (1..=spec.joints).collect();
@@ -100,54 +128,24 @@ pub fn system_structure(spec: &SspSpec) -> String {
     )
     .unwrap();
     s.push_str("    <ssd:Elements>\n");
+    let start = |name: &str| -> Vec<(String, f64)> {
+        joints
+            .iter()
+            .map(|j| (format!("{name}[{j}]"), START_ANGLE))
+            .collect()
+    };
     // The controller: the chain's state in, torques and energy out; its
     // start inputs equal the plant's start state (the first solve uses them).
-    writeln!(
-        s,
-        r#"      <ssd:Component name="controller" type="application/x-fmu-sharedlibrary" source="resources/{}.fmu">"#,
-        spec.controller
-    )
-    .unwrap();
-    s.push_str("        <ssd:Connectors>\n");
-    for n in &state {
-        connector(&mut s, n, "input");
-    }
-    for n in &torques {
-        connector(&mut s, n, "output");
-    }
-    connector(&mut s, "energy", "output");
-    s.push_str("        </ssd:Connectors>\n");
-    parameter_bindings(
+    component(
         &mut s,
-        &joints
-            .iter()
-            .map(|j| (format!("q[{j}]"), START_ANGLE))
-            .collect::<Vec<_>>(),
+        "controller",
+        spec.controller,
+        &state,
+        &torques,
+        &start("q"),
     );
-    s.push_str("      </ssd:Component>\n");
-    writeln!(
-        s,
-        r#"      <ssd:Component name="plant" type="application/x-fmu-sharedlibrary" source="resources/{}.fmu">"#,
-        spec.plant
-    )
-    .unwrap();
-    s.push_str("        <ssd:Connectors>\n");
-    for n in &torques {
-        connector(&mut s, n, "input");
-    }
-    for n in &state {
-        connector(&mut s, n, "output");
-    }
-    connector(&mut s, "energy", "output");
-    s.push_str("        </ssd:Connectors>\n");
-    parameter_bindings(
-        &mut s,
-        &joints
-            .iter()
-            .map(|j| (format!("q0[{j}]"), START_ANGLE))
-            .collect::<Vec<_>>(),
-    );
-    s.push_str("      </ssd:Component>\n    </ssd:Elements>\n    <ssd:Connections>\n");
+    component(&mut s, "plant", spec.plant, &torques, &state, &start("q0"));
+    s.push_str("    </ssd:Elements>\n    <ssd:Connections>\n");
     let connection = |s: &mut String, from: &str, to: &str, name: &str| {
         writeln!(
             s,
@@ -187,4 +185,37 @@ pub fn package(fmu_dir: &Path, spec: &SspSpec) -> Result<PathBuf> {
     }
     zip.finish()?;
     Ok(path)
+}
+
+#[cfg(test)]
+mod structure_check {
+    #[test]
+    fn every_state_and_torque_is_connected_once_and_both_fmus_start_at_rest_pose() {
+        for spec in super::SSPS {
+            let ssd = super::system_structure(spec);
+            let count = |needle: &str| ssd.matches(needle).count();
+            assert_eq!(count("<ssd:Component "), 2, "{}", spec.name);
+            // State (2 per joint) plant -> controller, torques controller -> plant.
+            assert_eq!(count("<ssd:Connection "), 3 * spec.joints, "{}", spec.name);
+            for j in 1..=spec.joints {
+                for (name, from, to) in [
+                    (format!("q[{j}]"), "plant", "controller"),
+                    (format!("qd[{j}]"), "plant", "controller"),
+                    (format!("tau[{j}]"), "controller", "plant"),
+                ] {
+                    assert_eq!(
+                        count(&format!(
+                            r#"startElement="{from}" startConnector="{name}" endElement="{to}""#
+                        )),
+                        1,
+                        "{}: {name}",
+                        spec.name
+                    );
+                }
+                assert_eq!(count(&format!(r#"name="q0[{j}]""#)), 1);
+            }
+            // Both components declare their energy output.
+            assert_eq!(count(r#"<ssd:Connector name="energy" kind="output">"#), 2);
+        }
+    }
 }

@@ -114,7 +114,10 @@ impl<const N: usize, const NX: usize, const NP: usize> AdaptiveController<N, NX,
         if self.adaptation.is_some() != state.adaptation.is_some() {
             return Err("the saved state has another adapt setting".into());
         }
-        let before = self.adaptation.as_ref().map(|_| self.controller.save_state());
+        let before = self
+            .adaptation
+            .as_ref()
+            .map(|_| self.controller.save_state());
         self.controller
             .restore_state(state.controller)
             .map_err(|e| e.to_string())?;
