@@ -52,7 +52,7 @@ per_sample() { # start qp variant
     echo
     echo "## Instructions per sample (callgrind; the same on every x86-64 machine for this build)"
     echo
-    echo "Paper set-up (N = 80, dt = 25 ms, 2 links), thousands of instructions per RTI sample, averaged over the 400 samples from 10 s to 20 s. \`rest\`: the paper's start at q = (0.05, 0.05), so 10-20 s is the torque-limited climb (the interior point works in most samples); \`orbit\`: from the 14 J in-phase eigenmode's turning point, on the orbit throughout (the steady state)."
+    echo "Paper set-up (N = 80, dt = 25 ms, 2 links), thousands of instructions per RTI sample, averaged over the 400 samples from 10 s to 20 s. \`rest\`: the paper's start at q = (0.05, 0.05), so 10-20 s is the torque-limited climb (saturated torques: active bounds in most QPs); \`orbit\`: from the 14 J in-phase eigenmode's turning point, on the orbit throughout (the steady state)."
     echo
     echo "| start | variant | QP | step (k instr.) | linearisation (k instr.) | QP solve (k instr.) |"
     echo "|---|---|---|---|---|---|"

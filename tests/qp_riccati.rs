@@ -262,8 +262,19 @@ fn semidefinite_state_cost() {
     }
     qp.q[15].fill(0.0);
     qp.q[15][(0, 0)] = 10.0;
-    let (sol, solver) = solve(&qp);
-    assert_matches("PSD Q", &qp, &sol, &clarabel_solve(&qp));
+    let reference = clarabel_solve(&qp);
+    let (sol, _) = solve(&qp);
+    assert_matches("PSD Q", &qp, &sol, &reference);
+    // The interior point alone (the active-set start has no pivots to
+    // truncate: its recursion factors only the control blocks).
+    let ip_only = RiccatiSettings {
+        active_set_start: false,
+        ..RiccatiSettings::default()
+    };
+    let mut solver = RiccatiSolver::new(4, 2, 15, ip_only);
+    let mut sol = QpSolution::new(4, 2, 15);
+    assert_eq!(solver.solve(&qp, &mut sol), QpStatus::Solved);
+    assert_matches("PSD Q, interior point", &qp, &sol, &reference);
     assert!(solver.info().truncated_pivots > 0);
     assert_eq!(solver.info().regularised_pivots, 0);
 }
@@ -440,15 +451,15 @@ fn warm_start_from_an_unrelated_solution_still_converges_to_the_same_point() {
 }
 
 #[test]
-fn inactive_start_gives_the_interior_point_solution() {
-    // RTI on an eigenmode: the bounds are far. The inactive-set start
-    // solves such QPs in one Riccati step, exactly where the interior point
-    // (the setting off) ends with no active bound, and gives the same point
-    // as it and clarabel; with an active bound it falls back to the
-    // interior point.
+fn active_set_start_gives_the_interior_point_solution() {
+    // Cold solves: the active-set start's first guess is "nothing active".
+    // Where the interior point (the setting off) ends with no active bound,
+    // that one Riccati recursion is the solution; with active bounds it
+    // takes more guesses or falls back to the interior point. Either way
+    // the same point as the interior point alone and clarabel.
     let mut rng = SplitMix64::new(91);
     let plain = RiccatiSettings {
-        inactive_start: false,
+        active_set_start: false,
         ..RiccatiSettings::default()
     };
     let mut cases: Vec<OcpQp> = vec![];
@@ -475,6 +486,7 @@ fn inactive_start_gives_the_interior_point_solution() {
         let mut reference_solver = RiccatiSolver::new(qp.nx, qp.nu, qp.horizon, plain);
         let mut ip = QpSolution::new(qp.nx, qp.nu, qp.horizon);
         assert_eq!(reference_solver.solve(qp, &mut ip), QpStatus::Solved);
+        assert!(!reference_solver.info().active_set_start);
         let largest_multiplier = ip
             .lam_u_lower
             .iter()
@@ -491,13 +503,9 @@ fn inactive_start_gives_the_interior_point_solution() {
             du < 1e-8,
             "{what}: controls differ from the interior point's by {du:e}"
         );
-        let one_step = solver.info().iterations == 1;
-        assert_eq!(
-            one_step,
-            !active,
-            "{what}: {} iterations",
-            solver.info().iterations
-        );
+        let info = solver.info();
+        let one_step = info.active_set_start && info.iterations == 1;
+        assert_eq!(one_step, !active, "{what}: {info:?}");
         if one_step {
             one_step_count += 1;
             // Multipliers of an inactive solution are exactly zero.
@@ -517,29 +525,127 @@ fn inactive_start_gives_the_interior_point_solution() {
     );
 }
 
+/// The QP's data moved by a relative `size` (a new RTI linearisation).
+fn perturbed(qp: &OcpQp, rng: &mut SplitMix64, size: f64) -> OcpQp {
+    let mut out = qp.clone();
+    let mut wiggle = |v: &mut f64| *v *= 1.0 + size * (2.0 * rng.unit() - 1.0);
+    for k in 0..qp.horizon {
+        out.a[k].iter_mut().for_each(&mut wiggle);
+        out.b[k].iter_mut().for_each(&mut wiggle);
+        out.c[k].iter_mut().for_each(&mut wiggle);
+        out.r_lin[k].iter_mut().for_each(&mut wiggle);
+    }
+    for k in 0..=qp.horizon {
+        out.q_lin[k].iter_mut().for_each(&mut wiggle);
+    }
+    out
+}
+
+/// The QP shifted by one stage, as the next RTI sample sees it.
+fn shifted(qp: &OcpQp) -> OcpQp {
+    let mut out = qp.clone();
+    let n = qp.horizon;
+    for k in 0..n - 1 {
+        out.a[k] = qp.a[k + 1].clone();
+        out.b[k] = qp.b[k + 1].clone();
+        out.c[k] = qp.c[k + 1].clone();
+        out.q[k] = qp.q[k + 1].clone();
+        out.s[k] = qp.s[k + 1].clone();
+        out.r[k] = qp.r[k + 1].clone();
+        out.q_lin[k] = qp.q_lin[k + 1].clone();
+        out.r_lin[k] = qp.r_lin[k + 1].clone();
+    }
+    out
+}
+
 #[test]
-fn inactive_start_is_skipped_after_an_active_solution_and_taken_again_later() {
-    let mut rng = SplitMix64::new(92);
+fn active_set_start_follows_the_shifted_active_set() {
+    // A sequence of RTI-like QPs with many saturated controls: each the
+    // previous one shifted by a stage and its data moved by 1 %. The
+    // active-set start, guessing the shifted previous active set, solves
+    // most of them in one or two recursions; every solution (whichever
+    // path) matches clarabel, multipliers included.
+    let mut rng = SplitMix64::new(93);
+    for (nx, nu, bound) in [(4, 2, 0.3), (6, 3, 0.3), (2, 1, 0.5)] {
+        let n = 60;
+        let mut qp = with_control_box(random_ocp_qp(&mut rng, nx, nu, n), bound);
+        let mut solver = RiccatiSolver::new(nx, nu, n, RiccatiSettings::default());
+        let mut sol = QpSolution::new(nx, nu, n);
+        let (mut taken, mut with_active, mut ip_iterations) = (0, 0, vec![]);
+        for sample in 0..30 {
+            assert_eq!(solver.solve(&qp, &mut sol), QpStatus::Solved);
+            let reference = clarabel_solve(&qp);
+            let what = format!("({nx}, {nu}) sample {sample}: {:?}", solver.info());
+            assert_matches(&what, &qp, &sol, &reference);
+            let active: usize = (0..n)
+                .map(|k| {
+                    (0..nu)
+                        .filter(|&j| (sol.u[k][j].abs() - bound).abs() < 1e-9)
+                        .count()
+                })
+                .sum();
+            let info = *solver.info();
+            if info.active_set_start {
+                taken += 1;
+                with_active += usize::from(active > 0);
+                assert!(info.iterations <= RiccatiSettings::default().active_set_guesses);
+                // Exact: the saturated controls sit on their bounds.
+                let du = (0..n)
+                    .map(|k| (&sol.u[k] - &reference.u[k]).amax())
+                    .fold(0.0, f64::max);
+                assert!(du < 1e-6, "{what}: controls {du:e} from clarabel's");
+            } else {
+                ip_iterations.push(info.iterations);
+            }
+            solver.shift_warm_start(true);
+            qp = perturbed(&shifted(&qp), &mut rng, 0.01);
+        }
+        eprintln!(
+            "({nx}, {nu}): active-set start took {taken} of 30 ({with_active} with active bounds); interior point iterations otherwise {ip_iterations:?}"
+        );
+        assert!(
+            taken >= 20 && with_active >= 15,
+            "({nx}, {nu}): {taken} / {with_active}"
+        );
+    }
+}
+
+#[test]
+fn active_set_start_gives_up_after_its_guesses() {
+    // A wrong guess that needs more than the allowed guesses: the interior
+    // point runs from the warm start and reaches the same point.
+    let mut rng = SplitMix64::new(94);
     let n = 40;
-    let tight = with_control_box(random_ocp_qp(&mut rng, 4, 2, n), 0.2);
-    let loose = with_control_box(random_ocp_qp(&mut rng, 4, 2, n), 50.0);
-    let mut solver = RiccatiSolver::new(4, 2, n, RiccatiSettings::default());
+    let tight = with_control_box(random_ocp_qp(&mut rng, 4, 2, n), 0.05);
+    let other = with_control_box(random_ocp_qp(&mut rng, 4, 2, n), 0.3);
+    let one_guess = RiccatiSettings {
+        active_set_guesses: 1,
+        ..RiccatiSettings::default()
+    };
+    let mut solver = RiccatiSolver::new(4, 2, n, one_guess);
     let mut sol = QpSolution::new(4, 2, n);
     assert_eq!(solver.solve(&tight, &mut sol), QpStatus::Solved);
-    assert!(solver.info().iterations > 1);
-    // The shifted multipliers say a bound was active: no one-step attempt.
     solver.shift_warm_start(true);
-    assert_eq!(solver.solve(&loose, &mut sol), QpStatus::Solved);
+    assert_eq!(solver.solve(&other, &mut sol), QpStatus::Solved);
+    assert!(!solver.info().active_set_start, "{:?}", solver.info());
     assert!(solver.info().iterations > 1);
     assert_matches(
-        "after the active solve",
-        &loose,
+        "after one wrong guess",
+        &other,
         &sol,
-        &clarabel_solve(&loose),
+        &clarabel_solve(&other),
     );
-    // Its solution has no active bound: the next one is tried and taken.
+    // The next sample of the other QP (shifted, from the predicted state):
+    // the shifted active set is right but near the horizon's end, and
+    // the default guesses find the solution.
+    let mut solver = RiccatiSolver::new(4, 2, n, RiccatiSettings::default());
+    let mut first = QpSolution::new(4, 2, n);
+    assert_eq!(solver.solve(&other, &mut first), QpStatus::Solved);
+    let mut next = shifted(&other);
+    next.x0 = first.x[1].clone();
     solver.shift_warm_start(true);
-    assert_eq!(solver.solve(&loose, &mut sol), QpStatus::Solved);
-    assert_eq!(solver.info().iterations, 1);
-    assert_matches("inactive-set start", &loose, &sol, &clarabel_solve(&loose));
+    let mut sol = QpSolution::new(4, 2, n);
+    assert_eq!(solver.solve(&next, &mut sol), QpStatus::Solved);
+    assert!(solver.info().active_set_start, "{:?}", solver.info());
+    assert_matches("the next sample", &next, &sol, &clarabel_solve(&next));
 }

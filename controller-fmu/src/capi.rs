@@ -104,7 +104,8 @@ pub struct EigenMpcConfig {
 pub struct EigenMpcStepInfo {
     /// Status code (`EIGENMPC_STATUS_*`), as returned by the step.
     pub status: i32,
-    /// Interior-point iterations of the step's QP(s).
+    /// QP iterations of the step (riccati: the active-set start's Riccati
+    /// recursions when it solved the QP, else interior-point iterations).
     pub qp_iterations: u32,
     /// Wall-clock time of the step: preparation + feedback (s).
     pub solve_time: f64,

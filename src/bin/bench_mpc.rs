@@ -109,7 +109,7 @@ fn main() {
         "## EigenMPC control step, N = 80, dt = 25 ms, {duration} s closed loop, both QP backends\n"
     );
     println!(
-        "Measured on {} ({} threads). The ratio column divides the sample median by clarabel's in the same run (same process, same machine state): it moves less between machines than the times.\n",
+        "Measured on {} ({} threads). The ratio column divides the sample median by clarabel's in the same run (same process, same machine state): it moves less between machines than the times. QP iterations are Riccati recursions per sample: the guesses of riccati's active-set start where it solves the QP, the interior point's iterations otherwise (clarabel: its interior-point iterations).\n",
         cpu(),
         std::thread::available_parallelism().map_or(1, |n| n.get())
     );

@@ -171,9 +171,9 @@ impl QpSolution {
 }
 
 /// Which [`QpSolver`] the controller builds: the structure-exploiting
-/// [`RiccatiSolver`] (the default: it matches clarabel on 1040 recorded RTI
-/// QPs and is ~6x faster, see docs/results.md) or the general-purpose
-/// clarabel (the reference).
+/// [`RiccatiSolver`] (the default: it matches clarabel on 1300 recorded RTI
+/// QPs and takes about a tenth of its time per RTI sample, see
+/// docs/speed.md) or the general-purpose clarabel (the reference).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum QpBackend {
     /// [`clarabel::ClarabelQpSolver`] with [`clarabel::rti_settings`].

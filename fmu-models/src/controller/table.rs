@@ -90,7 +90,7 @@ pub fn table<const N: usize>() -> Table<Settings<N>> {
             .summary("wall time of the last solve"),
         Rw::<N>::integer("qp_iterations", Shape::Scalar)
             .output()
-            .describe("Interior-point iterations of the last solve's QP(s)"),
+            .describe("QP iterations of the last solve (riccati: the active-set start's Riccati recursions when it solved the QP, else interior-point iterations)"),
         Rw::<N>::integer("solver_status", Shape::Scalar)
             .output()
             .describe(

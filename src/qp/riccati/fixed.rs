@@ -16,8 +16,12 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::{Core, Residuals, RiccatiInfo, RiccatiSettings, StartShift, add_slot, recentred};
-use crate::qp::{OcpQp, QpSolution, QpStatus};
+use crate::qp::{OcpQp, QpSolution};
 use nalgebra::{SMatrix, SVector};
+
+mod active_set;
+
+use active_set::GuessStage;
 
 type Mat<const R: usize, const C: usize> = SMatrix<f64, R, C>;
 type Vecn<const R: usize> = SVector<f64, R>;
@@ -220,17 +224,14 @@ pub(super) struct FixedCore<const NX: usize, const NU: usize, const M: usize> {
     pub(super) info: RiccatiInfo,
     /// Start the next solve from the shifted previous multipliers.
     pub(super) warm: bool,
-    /// Some state component has a soft bound (no inactive-set start).
+    /// Some state component has a soft bound (no active-set start).
     soft_any: bool,
-    /// Per stage: the masks, costates and multipliers kept aside while the
-    /// inactive-set start runs (restored when it fails).
-    kept: Vec<([f64; M], Vecn<NX>, [f64; M])>,
+    /// Per stage: the costates and multipliers kept aside while the
+    /// active-set start runs (the interior point's warm start when it fails).
+    kept: Vec<(Vecn<NX>, [f64; M])>,
+    /// Per stage: the active-set start's guess, policy and cost-to-go.
+    guess: Vec<GuessStage<NX, NU>>,
 }
-
-/// A previous multiplier above this marks a possibly active inequality:
-/// the inactive-set start is not tried. Inactive slots of a converged
-/// interior point have multipliers near `tol_complementarity / t`.
-const ACTIVE_MULTIPLIER: f64 = 1e-5;
 
 impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
     pub(super) fn new(horizon: usize) -> Self {
@@ -247,83 +248,9 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
             info: RiccatiInfo::default(),
             warm: false,
             soft_any: false,
-            kept: vec![([0.0; M], Vecn::zeros(), [0.0; M]); horizon + 1],
+            kept: vec![(Vecn::zeros(), [0.0; M]); horizon + 1],
+            guess: vec![GuessStage::new(); horizon + 1],
         }
-    }
-
-    /// The inactive-set start (see [`RiccatiSettings::inactive_start`]):
-    /// one Newton step on the QP without inequalities. Returns the status
-    /// when its solution is the QP's (every bound strictly satisfied,
-    /// residuals within tolerance, no regularised pivot); `None` leaves the
-    /// warm-start multipliers as they were for the interior point.
-    pub(super) fn solve_inactive(&mut self, sol: &mut QpSolution) -> Option<QpStatus> {
-        if !self.set.inactive_start || self.soft_any || self.m_on == 0 {
-            return None;
-        }
-        if self.warm
-            && self
-                .st
-                .iter()
-                .any(|st| st.lam.iter().any(|&l| l > ACTIVE_MULTIPLIER))
-        {
-            return None;
-        }
-        for (st, kept) in self.st.iter_mut().zip(self.kept.iter_mut()) {
-            *kept = (st.mask, st.pi, st.lam);
-            st.mask = [0.0; M];
-        }
-        let (m_on, warm) = (self.m_on, self.warm);
-        self.m_on = 0;
-        self.warm = false;
-        self.initialise();
-        self.residuals();
-        self.factor();
-        self.prepare_affine();
-        self.newton_direction();
-        self.take_step(1.0);
-        let res = self.residuals();
-        self.m_on = m_on;
-        self.warm = warm;
-        for (st, kept) in self.st.iter_mut().zip(&self.kept) {
-            st.mask = kept.0;
-        }
-        let set = &self.set;
-        let tol_stat = set
-            .tol_stationarity
-            .max(set.tol_stationarity_relative * res.scale);
-        let mut ok = res.stationarity <= tol_stat
-            && res.feasibility <= set.tol_feasibility
-            && self.info.regularised_pivots == 0;
-        for st in &mut self.st {
-            let cv = st.constraint_values();
-            for i in 0..M {
-                if st.mask[i] > 0.0 {
-                    ok &= cv[i] > 0.0;
-                    st.t[i] = cv[i];
-                } else {
-                    st.t[i] = 1.0;
-                }
-                st.lam[i] = 0.0;
-            }
-        }
-        if !ok {
-            for (st, kept) in self.st.iter_mut().zip(&self.kept) {
-                st.pi = kept.1;
-                st.lam = kept.2;
-            }
-            self.info = RiccatiInfo::default();
-            return None;
-        }
-        self.info.iterations = 1;
-        self.info.stationarity = res.stationarity;
-        self.info.feasibility = res.feasibility;
-        self.info.complementarity = 0.0;
-        self.write_solution(sol);
-        sol.iterations = 1;
-        sol.primal_residual = res.feasibility;
-        sol.dual_residual = res.stationarity;
-        sol.status = QpStatus::Solved;
-        Some(QpStatus::Solved)
     }
 
     /// The multipliers a warm start reads (`pi`, `lam` per stage), appended to `out`.

@@ -80,15 +80,23 @@ pub struct RiccatiSettings {
     /// solution sits on the boundary (products ~1e-11), where the Newton
     /// steps would be cut to nothing; 1e-2 measured best of 1e-1..1e-4.
     pub warm_start_floor: f64,
-    /// Before the interior point, try the QP without its inequalities when
-    /// none was active in the previous solution: one Riccati factorisation
-    /// and solve give the exact equality-constrained optimum, which is the
-    /// QP's optimum (all multipliers zero) when it satisfies every bound
-    /// strictly. RTI on an eigenmode runs torque-free, far from the bounds,
-    /// so most samples need no interior-point iteration (issue 12). Only
-    /// the compile-time-sized cores (1-3 joints) without soft state bounds
-    /// take this path.
-    pub inactive_start: bool,
+    /// Before the interior point, guess which control bounds are active (the
+    /// previous solution's, shifted by one stage; none after a cold start),
+    /// fix those controls at their bounds and solve the rest exactly by one
+    /// Riccati recursion; the guess is the QP's optimum when the free
+    /// controls are within their bounds and the fixed ones have multipliers
+    /// of the right sign, else a primal-dual active-set step makes the next
+    /// guess (at most [`RiccatiSettings::active_set_guesses`]). RTI on an
+    /// eigenmode runs torque-free, far from the bounds, so one recursion
+    /// with nothing fixed solves most samples (the inactive-set start); in
+    /// the torque-limited climb the saturated stages move little between
+    /// samples. When no guess is right the interior point runs from its
+    /// untouched warm start. Only the compile-time-sized cores (1-3 joints)
+    /// without soft state bounds take this path (issue 12).
+    pub active_set_start: bool,
+    /// Most guesses of the active-set start before the interior point takes
+    /// over.
+    pub active_set_guesses: usize,
 }
 
 impl Default for RiccatiSettings {
@@ -108,7 +116,8 @@ impl Default for RiccatiSettings {
             mehrotra_start: true,
             warm_start: true,
             warm_start_floor: 1e-2,
-            inactive_start: true,
+            active_set_start: true,
+            active_set_guesses: 4,
         }
     }
 }
@@ -116,8 +125,11 @@ impl Default for RiccatiSettings {
 /// What happened in the last [`RiccatiSolver::solve`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RiccatiInfo {
-    /// Interior-point iterations.
+    /// Interior-point iterations, or the active-set start's guesses when
+    /// it gave the solution.
     pub iterations: usize,
+    /// The active-set start gave the solution (no interior point ran).
+    pub active_set_start: bool,
     /// Control pivots lifted by regularisation over all factorisations of the
     /// solve (nonzero means an ill-conditioned or singular Hessian block).
     pub regularised_pivots: usize,
@@ -355,7 +367,7 @@ impl RiccatiSolver {
     }
 }
 
-/// One solve on a compile-time-sized core: the inactive-set start when it
+/// One solve on a compile-time-sized core: the active-set start when it
 /// applies, the interior point otherwise.
 fn run_fixed<const NX: usize, const NU: usize, const M: usize>(
     core: &mut FixedCore<NX, NU, M>,
@@ -366,7 +378,7 @@ fn run_fixed<const NX: usize, const NU: usize, const M: usize>(
 ) -> (QpStatus, RiccatiInfo) {
     core.load(qp, set);
     core.warm = warm;
-    let status = match core.solve_inactive(sol) {
+    let status = match core.solve_active_set(sol) {
         Some(status) => status,
         None => interior_point(core, set, warm, sol),
     };
