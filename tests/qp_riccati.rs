@@ -281,46 +281,71 @@ fn semidefinite_state_cost() {
 
 #[test]
 fn invalid_input_is_refused() {
-    let mut rng = SplitMix64::new(10);
-    let good = with_control_box(random_ocp_qp(&mut rng, 4, 2, 10), 1.0);
+    // (4, 2) runs on a compile-time-sized core, which checks the data while
+    // loading it; (5, 2) on the runtime-size core and its own check.
     type Corrupt = fn(&mut OcpQp);
-    let cases: [(&str, Corrupt); 12] = [
+    let cases: [(&str, Corrupt); 22] = [
         ("NaN in A", |qp| qp.a[3][(1, 2)] = f64::NAN),
         ("Inf in B", |qp| qp.b[9][(0, 1)] = f64::INFINITY),
+        ("Inf in c", |qp| qp.c[5][3] = f64::NEG_INFINITY),
         ("NaN in Q_N", |qp| qp.q[10][(2, 2)] = f64::NAN),
+        ("NaN in S", |qp| qp.s[1][(1, 3)] = f64::NAN),
+        ("NaN in R", |qp| qp.r[6][(1, 1)] = f64::NAN),
+        ("NaN in q", |qp| qp.q_lin[7][0] = f64::NAN),
         ("NaN in r", |qp| qp.r_lin[0][1] = f64::NAN),
         ("NaN in x0", |qp| qp.x0[0] = f64::NAN),
+        ("Inf in x0", |qp| qp.x0[3] = f64::INFINITY),
         ("NaN bound", |qp| qp.u_lower[2][0] = f64::NAN),
+        ("lower bound +inf", |qp| qp.u_lower[8][1] = f64::INFINITY),
         ("NaN state bound", |qp| qp.x_upper[2][0] = f64::NAN),
+        ("upper state bound -inf", |qp| {
+            qp.x_upper[10][1] = f64::NEG_INFINITY
+        }),
+        ("NaN bound of x_0", |qp| qp.x_lower[0][2] = f64::NAN),
         ("crossed control bounds", |qp| {
             qp.u_lower[4][1] = 1.0;
             qp.u_upper[4][1] = -1.0;
         }),
         ("negative penalty", |qp| qp.soft_l1[1] = -1.0),
+        ("NaN penalty", |qp| qp.soft_l2[0] = f64::NAN),
         ("asymmetric R", |qp| qp.r[1][(0, 1)] += 1.0),
+        ("asymmetric Q", |qp| qp.q[4][(3, 0)] += 1e-3),
         ("wrong horizon", |qp| qp.horizon = 9),
         ("wrong vector size", |qp| {
             qp.c[2] = nalgebra::DVector::zeros(3);
         }),
     ];
-    let mut solver = RiccatiSolver::new(4, 2, 10, RiccatiSettings::default());
-    let mut sol = QpSolution::new(4, 2, 10);
-    for (what, corrupt) in cases {
+    let mut rng = SplitMix64::new(10);
+    for (nx, nu) in [(4, 2), (5, 2)] {
+        let good = with_control_box(random_ocp_qp(&mut rng, nx, nu, 10), 1.0);
+        let mut solver = RiccatiSolver::new(nx, nu, 10, RiccatiSettings::default());
+        let mut sol = QpSolution::new(nx, nu, 10);
+        for (what, corrupt) in cases {
+            let mut qp = good.clone();
+            corrupt(&mut qp);
+            assert_eq!(
+                solver.solve(&qp, &mut sol),
+                QpStatus::InvalidInput,
+                "({nx}, {nu}) {what}"
+            );
+            assert_eq!(sol.status, QpStatus::InvalidInput, "{what}");
+            assert!(!sol.status.is_usable());
+            assert!(sol.objective.is_nan(), "{what}");
+            // The solver is still fine afterwards.
+            assert_eq!(
+                solver.solve(&good, &mut sol),
+                QpStatus::Solved,
+                "after {what}"
+            );
+        }
+        // Asymmetry at round-off is accepted.
         let mut qp = good.clone();
-        corrupt(&mut qp);
-        assert_eq!(
-            solver.solve(&qp, &mut sol),
-            QpStatus::InvalidInput,
-            "{what}"
-        );
-        assert_eq!(sol.status, QpStatus::InvalidInput, "{what}");
-        assert!(!sol.status.is_usable());
+        qp.q[4][(3, 0)] += 1e-14;
+        assert_eq!(solver.solve(&qp, &mut sol), QpStatus::Solved);
+        // A QP of other dimensions is refused too.
+        let other = random_ocp_qp(&mut rng, nx, nu, 11);
+        assert_eq!(solver.solve(&other, &mut sol), QpStatus::InvalidInput);
     }
-    // The solver is still fine afterwards.
-    assert_eq!(solver.solve(&good, &mut sol), QpStatus::Solved);
-    // A QP of other dimensions is refused too.
-    let other = random_ocp_qp(&mut rng, 4, 2, 11);
-    assert_eq!(solver.solve(&other, &mut sol), QpStatus::InvalidInput);
 }
 
 #[test]

@@ -275,21 +275,37 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
         true
     }
 
-    /// Copies the (validated) QP into the stage blocks and marks the
-    /// existing inequalities.
-    pub(super) fn load(&mut self, qp: &OcpQp, set: &RiccatiSettings) {
+    /// Copies the QP (of checked dimensions) into the stage blocks and
+    /// marks the existing inequalities, checking the data on the way (one
+    /// pass instead of a separate validation): false, and nothing to solve,
+    /// for a non-finite entry, a NaN or wrong-way infinite bound, crossed
+    /// control bounds, a negative penalty or an asymmetric `Q` or `R` (the
+    /// same rules as the runtime-size core's `valid_data`).
+    pub(super) fn load(&mut self, qp: &OcpQp, set: &RiccatiSettings) -> bool {
         let n = self.n;
         self.set = *set;
         self.info = RiccatiInfo::default();
-        let copy = |dst: &mut [f64], src: &[f64]| dst.copy_from_slice(src);
+        // v * 0 is 0 for a finite v and NaN otherwise; four lanes keep the
+        // sums independent chains.
+        let mut probe = [0.0f64; 4];
+        let mut copy = |dst: &mut [f64], src: &[f64]| {
+            dst.copy_from_slice(src);
+            for (i, v) in src.iter().enumerate() {
+                probe[i & 3] += v * 0.0;
+            }
+        };
         copy(self.l1.as_mut_slice(), qp.soft_l1.as_slice());
         copy(self.l2.as_mut_slice(), qp.soft_l2.as_slice());
         copy(self.x0.as_mut_slice(), qp.x0.as_slice());
+        let mut ok = self.l1.iter().chain(self.l2.iter()).all(|&w| w >= 0.0);
+        let lower_ok = |l: f64| !l.is_nan() && l != f64::INFINITY;
+        let upper_ok = |u: f64| !u.is_nan() && u != f64::NEG_INFINITY;
         let mut m_on = 0.0;
         self.soft_any = false;
         for (k, st) in self.st.iter_mut().enumerate() {
             copy(st.q.as_mut_slice(), qp.q[k].as_slice());
             copy(st.ql.as_mut_slice(), qp.q_lin[k].as_slice());
+            ok &= symmetric(&st.q);
             st.mask = [0.0; M];
             st.off = [0.0; M];
             if k < n {
@@ -299,8 +315,10 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
                 copy(st.s.as_mut_slice(), qp.s[k].as_slice());
                 copy(st.r.as_mut_slice(), qp.r[k].as_slice());
                 copy(st.rl.as_mut_slice(), qp.r_lin[k].as_slice());
+                ok &= symmetric(&st.r);
                 let (lo, hi) = (&qp.u_lower[k], &qp.u_upper[k]);
                 for j in 0..NU {
+                    ok &= lower_ok(lo[j]) && upper_ok(hi[j]) && lo[j] <= hi[j];
                     if lo[j].is_finite() {
                         st.mask[j] = 1.0;
                         st.off[j] = -lo[j];
@@ -312,8 +330,12 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
                 }
             }
             st.soft = Vecn::zeros();
+            // x_0 is fixed: its bounds are ignored, but must be valid too.
+            let (lo, hi) = (&qp.x_lower[k], &qp.x_upper[k]);
+            for i in 0..NX {
+                ok &= lower_ok(lo[i]) && upper_ok(hi[i]);
+            }
             if k >= 1 {
-                let (lo, hi) = (&qp.x_lower[k], &qp.x_upper[k]);
                 for i in 0..NX {
                     // A bound whose weights are both zero costs nothing to
                     // violate: ignored (as in the KKT checker).
@@ -337,6 +359,7 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
             self.soft_any |= st.soft.iter().any(|&v| v > 0.0);
         }
         self.m_on = m_on as usize;
+        ok && probe.iter().sum::<f64>() == 0.0
     }
 
     /// Lower Cholesky factor in place with the parent module's pivot rules:
@@ -409,6 +432,23 @@ fn fmax(a: f64, b: f64) -> f64 {
 #[inline(always)]
 fn nan_probe(v: f64) -> f64 {
     v * 0.0
+}
+
+/// A Hessian block symmetric to round-off (the kernels read its lower
+/// triangle): as the runtime-size core's check, relative to its largest
+/// entry. Not finite entries are left to the NaN probe.
+#[inline(always)]
+fn symmetric<const D: usize>(m: &Mat<D, D>) -> bool {
+    let (mut scale, mut asym) = (0.0f64, 0.0f64);
+    for j in 0..D {
+        for i in 0..D {
+            scale = fmax(scale, m[(i, j)].abs());
+        }
+        for i in j + 1..D {
+            asym = fmax(asym, (m[(i, j)] - m[(j, i)]).abs());
+        }
+    }
+    asym <= 1e-10 * scale
 }
 
 /// `L (L' v) + p` for a lower-triangular `L` (the cost-to-go Hessian times

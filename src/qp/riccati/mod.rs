@@ -376,7 +376,9 @@ fn run_fixed<const NX: usize, const NU: usize, const M: usize>(
     warm: bool,
     sol: &mut QpSolution,
 ) -> (QpStatus, RiccatiInfo) {
-    core.load(qp, set);
+    if !core.load(qp, set) {
+        return (QpStatus::InvalidInput, core.info);
+    }
     core.warm = warm;
     let status = match core.solve_active_set(sol) {
         Some(status) => status,
@@ -457,9 +459,11 @@ impl QpSolver for RiccatiSolver {
 
     fn solve(&mut self, qp: &OcpQp, solution: &mut QpSolution) -> QpStatus {
         self.info = RiccatiInfo::default();
+        // The compile-time-sized cores check the data while loading it.
+        let runtime = matches!(self.engine, Engine::Runtime(_));
         let status = if !valid_dimensions(qp, self.nx, self.nu, self.horizon)
             || !valid_solution(solution, self.nx, self.nu, self.horizon)
-            || !valid_data(qp)
+            || (runtime && !valid_data(qp))
         {
             QpStatus::InvalidInput
         } else {

@@ -210,12 +210,13 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
                     feed[j] = fixed[j];
                 }
             }
-            // V(x) = Q(x, gain x + feed): the general form, valid for a
-            // policy that is not the unconstrained minimiser.
-            let quu_gain = quu * gain;
-            let cross = qux.tr_mul(&gain);
-            let p_mat = qxx + cross + cross.transpose() + gain.tr_mul(&quu_gain);
-            let p_vec = qx + gain.tr_mul(&qu) + qux.tr_mul(&feed) + gain.tr_mul(&(quu * feed));
+            // V(x) = Q(x, gain x + feed). The free rows of the policy solve
+            // Quu_FF gain_F = -Qux_F and Quu_FF feed_F = -(qu_F + Quu_Fa b_a),
+            // and the fixed rows of gain are zero, so gain' Quu gain =
+            // -gain' Qux and gain' Quu feed = -gain' qu: the quadratic and
+            // linear terms reduce to the familiar Riccati update.
+            let p_mat = qxx + qux.tr_mul(&gain);
+            let p_vec = qx + qux.tr_mul(&feed);
             let gs = &mut self.guess[k];
             gs.gain = gain;
             gs.feed = feed;
