@@ -114,10 +114,21 @@ fn bad_input_gives_one_line_errors_and_nonzero_exit() {
             vec!["modes", "--energies", "70"],
             "cannot be continued beyond",
         ),
-        // A nearly massless second link: the family by its name, and the
-        // energy asked for (not the continuation's internal start).
+        // The controller FMU's ranges (m in [1e-6, 1e6] kg, l in
+        // [1e-3, 1e3] m), naming the flag.
         (
             vec!["modes", "--energies", "14", "--m2", "1e-9"],
+            "--m2: m[2] = 1e-9 is below its minimum 1e-6",
+        ),
+        (
+            vec!["modes", "--energies", "14", "--l2", "1e9"],
+            "--l2: l[2] = 1e9 is above its maximum 1e3",
+        ),
+        // A nearly massless second link (the smallest mass allowed): the
+        // family by its name, and the energy asked for (not the
+        // continuation's internal start).
+        (
+            vec!["modes", "--energies", "14", "--m2", "1e-6"],
             "the in-phase family cannot be continued beyond E = 0.0000 J (requested 14 J): no orbit \
              at the continuation's start energy 0.05 J",
         ),

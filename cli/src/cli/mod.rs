@@ -10,6 +10,8 @@ mod sweep;
 use clap::{Args, Parser, Subcommand};
 use eigenmpc::mechanics::{DoublePendulum, PlanarChainParams};
 use eigenmpc::model_file::RobotFile;
+use eigenmpc_fmu_models::controller::named::check_named;
+use eigenmpc_fmu_models::products::EigenMpc2;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -107,14 +109,29 @@ impl ModelArgs {
                     file: Some(file),
                 }
             }
-            None => Robot {
-                system: DoublePendulum::new(PlanarChainParams::point_masses(
-                    [self.m1, self.m2],
-                    [self.l1, self.l2],
-                    self.g,
-                ))?,
-                file: None,
-            },
+            None => {
+                // The controller FMU's ranges for the same parameters: one
+                // set of limits for every entry point (m in [1e-6, 1e6] kg,
+                // l in [1e-3, 1e3] m, g in [0, 1e3] m/s^2).
+                for (flag, name, value) in [
+                    ("--m1", "m[1]", self.m1),
+                    ("--m2", "m[2]", self.m2),
+                    ("--l1", "l[1]", self.l1),
+                    ("--l2", "l[2]", self.l2),
+                    ("--g", "g", self.g),
+                ] {
+                    check_named::<EigenMpc2, 2>(name, value)
+                        .map_err(|e| anyhow::anyhow!("{flag}: {e}"))?;
+                }
+                Robot {
+                    system: DoublePendulum::new(PlanarChainParams::point_masses(
+                        [self.m1, self.m2],
+                        [self.l1, self.l2],
+                        self.g,
+                    ))?,
+                    file: None,
+                }
+            }
         })
     }
 }
