@@ -20,20 +20,22 @@ mhz=$(grep -m1 'cpu MHz' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//' || true)
 flags=$(grep -m1 '^flags' /proc/cpuinfo | tr ' ' '\n' | grep -E '^(avx2|fma|avx512f)$' | tr '\n' ' ' || true)
 
 # Instructions of Controller::step, of its linearisation and of its QP solve
-# per sample: two run lengths subtracted, so the first sample (converged SQP
-# from a cold start) drops out.
-count() { # start seconds qp variant -> "step linearise qp" (inclusive Ir)
+# per sample: each counted alone (callgrind collecting only inside the
+# function), two run lengths subtracted so that the first sample (converged
+# SQP from a cold start) drops out.
+total() { # function-pattern start seconds qp variant -> instructions
     local file
     file=$(mktemp)
     valgrind --tool=callgrind --callgrind-out-file="$file" \
-        --toggle-collect='*Controller*step*' "$profile" "$@" >/dev/null 2>&1
-    callgrind_annotate --inclusive=yes "$file" 2>/dev/null | awk '
-        function n(s) { gsub(",", "", s); return s + 0 }
-        /Controller<S,_,_>::step \[/ && !step { step = n($1) }
-        /Controller<S,_,_>>::linearise \[/ && !lin { lin = n($1) }
-        /as eigenmpc::qp::QpSolver>::solve \[/ && !qp { qp = n($1) }
-        END { print step, lin, qp }'
+        --toggle-collect="$1" "$profile" "${@:2}" >/dev/null 2>&1
+    callgrind_annotate "$file" 2>/dev/null | awk '
+        /PROGRAM TOTALS/ { gsub(",", "", $1); print $1; exit }'
     rm -f "$file"
+}
+count() { # start seconds qp variant -> "step linearise qp"
+    echo "$(total '*Controller<S,_,_>::step' "$@") \
+$(total '*Controller<S,_,_>>::linearise' "$@") \
+$(total '*as eigenmpc::qp::QpSolver>::solve' "$@")"
 }
 per_sample() { # start qp variant
     local a b
