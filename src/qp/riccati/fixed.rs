@@ -15,7 +15,10 @@
 // nested zips, and the constant bounds let the loops unroll.
 #![allow(clippy::needless_range_loop)]
 
-use super::{Core, Residuals, RiccatiInfo, RiccatiSettings, StartShift, add_slot, recentred};
+use super::{
+    Core, Residuals, RiccatiInfo, RiccatiSettings, SYMMETRY_TOLERANCE, StartShift, add_slot,
+    lower_bound_ok, recentred, upper_bound_ok,
+};
 use crate::qp::{OcpQp, QpSolution};
 use nalgebra::{SMatrix, SVector};
 
@@ -285,21 +288,18 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
         let n = self.n;
         self.set = *set;
         self.info = RiccatiInfo::default();
-        // v * 0 is 0 for a finite v and NaN otherwise; four lanes keep the
-        // sums independent chains.
+        // Four lanes of NaN probes keep the sums independent chains.
         let mut probe = [0.0f64; 4];
         let mut copy = |dst: &mut [f64], src: &[f64]| {
             dst.copy_from_slice(src);
             for (i, v) in src.iter().enumerate() {
-                probe[i & 3] += v * 0.0;
+                probe[i & 3] += nan_probe(*v);
             }
         };
         copy(self.l1.as_mut_slice(), qp.soft_l1.as_slice());
         copy(self.l2.as_mut_slice(), qp.soft_l2.as_slice());
         copy(self.x0.as_mut_slice(), qp.x0.as_slice());
         let mut ok = self.l1.iter().chain(self.l2.iter()).all(|&w| w >= 0.0);
-        let lower_ok = |l: f64| !l.is_nan() && l != f64::INFINITY;
-        let upper_ok = |u: f64| !u.is_nan() && u != f64::NEG_INFINITY;
         let mut m_on = 0.0;
         self.soft_any = false;
         for (k, st) in self.st.iter_mut().enumerate() {
@@ -318,7 +318,7 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
                 ok &= symmetric(&st.r);
                 let (lo, hi) = (&qp.u_lower[k], &qp.u_upper[k]);
                 for j in 0..NU {
-                    ok &= lower_ok(lo[j]) && upper_ok(hi[j]) && lo[j] <= hi[j];
+                    ok &= lower_bound_ok(lo[j]) && upper_bound_ok(hi[j]) && lo[j] <= hi[j];
                     if lo[j].is_finite() {
                         st.mask[j] = 1.0;
                         st.off[j] = -lo[j];
@@ -333,7 +333,7 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
             // x_0 is fixed: its bounds are ignored, but must be valid too.
             let (lo, hi) = (&qp.x_lower[k], &qp.x_upper[k]);
             for i in 0..NX {
-                ok &= lower_ok(lo[i]) && upper_ok(hi[i]);
+                ok &= lower_bound_ok(lo[i]) && upper_bound_ok(hi[i]);
             }
             if k >= 1 {
                 for i in 0..NX {
@@ -448,7 +448,7 @@ fn symmetric<const D: usize>(m: &Mat<D, D>) -> bool {
             asym = fmax(asym, (m[(i, j)] - m[(j, i)]).abs());
         }
     }
-    asym <= 1e-10 * scale
+    asym <= SYMMETRY_TOLERANCE * scale
 }
 
 /// `L (L' v) + p` for a lower-triangular `L` (the cost-to-go Hessian times

@@ -525,6 +525,20 @@ fn valid_solution(sol: &QpSolution, nx: usize, nu: usize, n: usize) -> bool {
         && vecs(&sol.lam_u_upper, nu, n)
 }
 
+/// Largest asymmetry of a Hessian block accepted, relative to its largest
+/// entry (the solver reads the lower triangles).
+const SYMMETRY_TOLERANCE: f64 = 1e-10;
+
+/// A lower bound may be `-inf` (none), not NaN or `+inf`.
+fn lower_bound_ok(l: f64) -> bool {
+    !l.is_nan() && l != f64::INFINITY
+}
+
+/// An upper bound may be `+inf` (none), not NaN or `-inf`.
+fn upper_bound_ok(u: f64) -> bool {
+    !u.is_nan() && u != f64::NEG_INFINITY
+}
+
 /// Finite data, consistent bounds, nonnegative penalties and symmetric
 /// Hessian blocks (the solver reads their lower triangles).
 fn valid_data(qp: &OcpQp) -> bool {
@@ -558,7 +572,7 @@ fn valid_data(qp: &OcpQp) -> bool {
             }
         }
         let max = |l: [f64; 4]| l[0].max(l[1]).max(l[2].max(l[3]));
-        max(asym) <= 1e-10 * max(scale)
+        max(asym) <= SYMMETRY_TOLERANCE * max(scale)
     };
     let mats = [&qp.q, &qp.s, &qp.r, &qp.a, &qp.b];
     if !mats.iter().all(|v| v.iter().all(|m| finite(m.as_slice()))) {
@@ -578,17 +592,15 @@ fn valid_data(qp: &OcpQp) -> bool {
     if !qp.q.iter().chain(qp.r.iter()).all(symmetric) {
         return false;
     }
-    let lower_ok = |l: f64| !l.is_nan() && l != f64::INFINITY;
-    let upper_ok = |u: f64| !u.is_nan() && u != f64::NEG_INFINITY;
     let u_ok = qp.u_lower.iter().zip(&qp.u_upper).all(|(l, u)| {
         l.iter()
             .zip(u.iter())
-            .all(|(&l, &u)| lower_ok(l) && upper_ok(u) && l <= u)
+            .all(|(&l, &u)| lower_bound_ok(l) && upper_bound_ok(u) && l <= u)
     });
     let x_ok = qp.x_lower.iter().zip(&qp.x_upper).all(|(l, u)| {
         l.iter()
             .zip(u.iter())
-            .all(|(&l, &u)| lower_ok(l) && upper_ok(u))
+            .all(|(&l, &u)| lower_bound_ok(l) && upper_bound_ok(u))
     });
     u_ok && x_ok
 }
