@@ -1,16 +1,30 @@
-//! Online adaptation of a controller's model: the energy-balance
-//! identification ([`crate::identify`]) is fed every sample; when its
-//! estimate has moved, the new model and its eigenmode family are computed
-//! on a worker thread (tens of milliseconds: never inside a sample) and
-//! swapped into the controller at the first sample after they are ready.
+//! Online adaptation of a controller's model, safe to leave on: the
+//! energy-balance identification ([`crate::identify`]) is fed every sample
+//! with the torque the robot felt over the measured interval (after the
+//! measurement delay and the actuator's lag); a model is made of its
+//! estimate only when it
 //!
-//! The per-sample path ([`Adaptation::sample`]) does not allocate and never
-//! waits: it feeds the identification, and at most once per `period`
-//! samples posts a request or takes a finished result through a mutex it
-//! only `try_lock`s. The family the controller drops is handed back to the
-//! worker, which frees it.
+//! 1. is physical and inside a trust region around the model in use (a
+//!    longer step is shortened to the region's edge);
+//! 2. explains the windows that arrive *after* it was formed (held out from
+//!    it) significantly better than the model in use;
+//!
+//! and, once swapped in, a **supervisor** watches the closed loop: when the
+//! energy error or the torque rose over a window, the previous model comes
+//! back ([`AdaptationEvent::Reverted`]). Refusals are counted per reason
+//! ([`Refusal`]) so that a caller logs each reason once.
+//!
+//! A new model's eigenmode family takes tens of milliseconds: it is computed
+//! on a worker thread while the candidate is being validated, never inside
+//! a sample. The per-sample path ([`Adaptation::sample`]) does not allocate
+//! and never waits (unless `synchronous`, for offline simulation): it feeds
+//! the identification, and at most once per `period` samples looks at the
+//! candidate through a mutex it only `try_lock`s. Families the controller
+//! drops are handed back to the worker, which frees them.
 
-use crate::identify::{BaseParameters, EnergyBalanceRls, IdentifyError, RlsOptions};
+use crate::identify::{
+    BaseParameters, EnergyBalanceRls, IdentifyError, RlsOptions, WindowEquation, energy_features,
+};
 use crate::mechanics::{PlanarChain, PlanarChainParams, Vector};
 use crate::modes::{ChartFamily, FamilyOptions};
 use crate::mpc::{Controller, prediction_substeps};
@@ -18,19 +32,39 @@ use nalgebra::SVector;
 use std::sync::{Arc, Condvar, Mutex};
 use std::thread::JoinHandle;
 
-/// When the model follows the estimate.
+/// Longest measurement delay the torque alignment covers (samples).
+pub const MAX_DELAY_SAMPLES: usize = 64;
+
+/// When and how the model follows the estimate.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AdaptOptions {
     /// Samples between two looks at the estimate (>= 1).
     pub period: usize,
     /// Relative change of a base parameter (against its value in use plus
-    /// the identification's `prior_floor`) that triggers a new model.
+    /// the identification's `prior_floor`) that makes a candidate model.
     pub min_change: f64,
+    /// Largest relative change of a base parameter per model (the trust
+    /// region); a longer step is shortened to its edge.
+    pub trust_region: f64,
+    /// Held-out windows a candidate is scored on before it may be taken.
+    pub min_validation_windows: usize,
+    /// Held-out windows after which a candidate not shown better is refused.
+    pub max_validation_windows: usize,
+    /// Samples the supervisor waits after a model change before it judges.
+    pub settle_samples: usize,
+    /// Samples of each window the supervisor compares (before the change,
+    /// and at the end of its watch).
+    pub judge_samples: usize,
     /// Top of a new model's mode family (J); `<= 0`: the default of
     /// [`FamilyOptions::for_system`] for the new model.
     pub family_energy_max: f64,
     /// Identification settings.
     pub rls: RlsOptions,
+    /// Measurement delay (s): the state measured now is the robot's this
+    /// long ago, so the torque that moved it was sent this long before.
+    pub measurement_delay: f64,
+    /// Time constant of the actuator's first-order lag (s, 0: none).
+    pub actuator_time_constant: f64,
     /// Offline simulation: wait for the worker's model at the next look
     /// (deterministic closed loops whatever the machine's speed). Never for
     /// a real-time loop.
@@ -42,11 +76,141 @@ impl Default for AdaptOptions {
         Self {
             period: 40,
             min_change: 1e-2,
+            trust_region: 0.3,
+            min_validation_windows: 6,
+            max_validation_windows: 24,
+            settle_samples: 160,
+            judge_samples: 80,
             family_energy_max: -1.0,
             rls: RlsOptions::default(),
+            measurement_delay: 0.0,
+            actuator_time_constant: 0.0,
             synchronous: false,
         }
     }
+}
+
+impl AdaptOptions {
+    /// Checks the options; the message names the offending one.
+    pub fn validate(&self, dt: f64) -> Result<(), IdentifyError> {
+        let bad = |what: String| Err(IdentifyError::NotPhysical(what));
+        for (name, v) in [
+            ("min_change", self.min_change),
+            ("trust_region", self.trust_region),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return bad(format!("{name} = {v} must be finite and > 0"));
+            }
+        }
+        if self.min_validation_windows == 0
+            || self.max_validation_windows < self.min_validation_windows
+        {
+            return bad(format!(
+                "validation windows {}..{} must satisfy 1 <= min <= max",
+                self.min_validation_windows, self.max_validation_windows
+            ));
+        }
+        if self.judge_samples == 0 {
+            return bad("judge_samples must be >= 1".into());
+        }
+        if !(self.measurement_delay.is_finite()
+            && self.measurement_delay >= 0.0
+            && self.measurement_delay <= dt * (MAX_DELAY_SAMPLES - 2) as f64)
+        {
+            return bad(format!(
+                "measurement_delay = {} s must be in [0, {} samples]",
+                self.measurement_delay,
+                MAX_DELAY_SAMPLES - 2
+            ));
+        }
+        if !(self.actuator_time_constant.is_finite() && self.actuator_time_constant >= 0.0) {
+            return bad(format!(
+                "actuator_time_constant = {} must be finite and >= 0",
+                self.actuator_time_constant
+            ));
+        }
+        self.rls.validate()
+    }
+}
+
+/// Why a candidate model was not taken (one count each).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum Refusal {
+    /// The estimate (shortened to the trust region) is not a physical chain.
+    NotPhysical,
+    /// It did not explain the held-out windows significantly better than
+    /// the model in use.
+    NotBetter,
+    /// Its model or mode family could not be computed, or the controller
+    /// refused it.
+    ModelFailed,
+}
+
+impl Refusal {
+    /// Every reason, in the order of [`Adaptation::refusals`].
+    pub const ALL: [Refusal; 3] = [
+        Refusal::NotPhysical,
+        Refusal::NotBetter,
+        Refusal::ModelFailed,
+    ];
+
+    /// What the reason means, for a log.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Refusal::NotPhysical => {
+                "the estimate is not a physical chain (negative mass, inertia, friction)"
+            }
+            Refusal::NotBetter => {
+                "it did not explain the windows measured after it significantly better than the \
+                 model in use"
+            }
+            Refusal::ModelFailed => "its model or mode family could not be computed",
+        }
+    }
+}
+
+/// What the adaptation is doing (the FMU's `adaptation_status`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum AdaptationStatus {
+    /// No window has informed the estimate yet.
+    Idle,
+    /// Gathering information the estimate lacks (its scale).
+    Excitation,
+    /// A candidate is being validated or a new model supervised.
+    Learning,
+    /// The estimate agrees with the model in use.
+    Converged,
+    /// The last model was taken back by the supervisor.
+    Reverted,
+}
+
+/// Something a caller may want to log, with its figures.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum AdaptationEvent {
+    /// A model was swapped in; `improvement` is its score on the held-out
+    /// windows (sum of squared errors in units of their variance, the
+    /// model in use minus the new one) over `windows` windows.
+    Accepted {
+        /// Score gained on the held-out windows.
+        improvement: f64,
+        /// Held-out windows scored.
+        windows: usize,
+    },
+    /// A candidate was refused.
+    Refused(Refusal),
+    /// The supervisor took the last model back: over its window, the RMS
+    /// torque (N m, all joints) and the RMS energy error (J) before the
+    /// change and after.
+    Reverted {
+        /// RMS torque before the change.
+        torque_before: f64,
+        /// RMS torque at the end of the watch.
+        torque_after: f64,
+        /// RMS energy error before the change.
+        energy_before: f64,
+        /// RMS energy error at the end of the watch.
+        energy_after: f64,
+    },
 }
 
 /// A request to the worker: the model's parameters and, for a controller
@@ -75,6 +239,73 @@ struct Slot<const N: usize> {
     quit: bool,
 }
 
+/// Mean squares of the closed loop over a block of samples.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+struct Block {
+    torque: f64,
+    energy: f64,
+    samples: usize,
+}
+
+impl Block {
+    fn add(&mut self, torque2: f64, energy2: f64) {
+        self.torque += torque2;
+        self.energy += energy2;
+        self.samples += 1;
+    }
+
+    /// `(RMS torque, RMS energy error)`.
+    fn rms(&self) -> (f64, f64) {
+        let n = self.samples.max(1) as f64;
+        ((self.torque / n).sqrt(), (self.energy / n).sqrt())
+    }
+}
+
+/// The candidate being scored on held-out windows, and its model being
+/// computed.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+struct Candidate<const N: usize, const NP: usize> {
+    theta: SVector<f64, NP>,
+    request: Request<N>,
+    /// Sum over the windows of `(e_in_use^2 - e_candidate^2) / R`.
+    score: f64,
+    /// Sum of `(h' (theta_c - theta_u))^2 / R`: how far apart the two
+    /// models' predictions are (the score's expectation if the candidate is
+    /// right).
+    distinct: f64,
+    windows: usize,
+}
+
+/// A model swapped in and the one it replaced, under watch.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+struct Watch<const N: usize, const NP: usize> {
+    previous_theta: SVector<f64, NP>,
+    previous_model: PlanarChain<N>,
+    previous_family: Option<ChartFamily<N>>,
+    previous_substeps: usize,
+    before: Block,
+    /// The first block after the change (the energy error the new model
+    /// starts from).
+    early: Block,
+    /// The last `judge_samples` of the watch.
+    after: Block,
+    /// The current `period` of the watch, and whether one showed the
+    /// torque far above the one before while the energy error grew.
+    current: Block,
+    last_energy: f64,
+    strikes: usize,
+    alarm: bool,
+    samples: usize,
+}
+
+/// What the adaptation is doing between two looks.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+enum Phase<const N: usize, const NP: usize> {
+    Watching,
+    Validating(Candidate<N, NP>),
+    Supervising(Watch<N, NP>),
+}
+
 /// Identification plus model updates of one controller on an `N`-joint
 /// chain (`NX = 2 N`, `NP` = [`crate::identify::base_parameter_count`]`(N)`).
 pub struct Adaptation<const N: usize, const NX: usize, const NP: usize> {
@@ -83,18 +314,29 @@ pub struct Adaptation<const N: usize, const NX: usize, const NP: usize> {
     rls: EnergyBalanceRls<N, NP>,
     /// Base parameters of the model the controller has.
     in_use: SVector<f64, NP>,
-    /// Base parameters of the model the worker is computing.
-    posted: SVector<f64, NP>,
-    pending: bool,
-    /// The request the worker is computing (kept for a saved state).
-    request: Option<Request<N>>,
+    phase: Phase<N, NP>,
+    /// A candidate this close to the last reverted model is not tried again.
+    reverted_theta: Option<SVector<f64, NP>>,
+    /// Torque the robot felt over each of the last intervals (newest
+    /// first), and the actuator's output now.
+    felt: [Vector<N>; MAX_DELAY_SAMPLES],
+    actuator: Vector<N>,
+    /// The closed loop's last `judge_samples` (before a change).
+    recent: Block,
+    recent_done: Block,
+    recent_prev: Block,
     /// Answers to requests of another generation are dropped: a restored
     /// state ([`Adaptation::restore_state`]) starts a new one.
     generation: u64,
-    /// Requests whose model or family could not be computed.
-    failures: usize,
     samples: usize,
+    /// No candidate before this sample (after a revert).
+    hold_until: usize,
     updates: usize,
+    reverts: usize,
+    refusals: [usize; 3],
+    last_event: Option<(usize, AdaptationEvent)>,
+    events: usize,
+    status: AdaptationStatus,
     shared: Arc<(Mutex<Slot<N>>, Condvar)>,
     worker: Option<JoinHandle<()>>,
 }
@@ -123,17 +365,27 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
             prior: *prior,
             options: AdaptOptions {
                 period: options.period.max(1),
+                judge_samples: options.judge_samples.max(1),
                 ..options
             },
             rls,
             in_use,
-            posted: in_use,
-            pending: false,
-            request: None,
+            phase: Phase::Watching,
+            reverted_theta: None,
+            felt: [Vector::zeros(); MAX_DELAY_SAMPLES],
+            actuator: Vector::zeros(),
+            recent: Block::default(),
+            recent_done: Block::default(),
+            recent_prev: Block::default(),
             generation: 0,
-            failures: 0,
             samples: 0,
+            hold_until: 0,
             updates: 0,
+            reverts: 0,
+            refusals: [0; 3],
+            last_event: None,
+            events: 0,
+            status: AdaptationStatus::Idle,
             shared,
             worker: Some(worker),
         })
@@ -144,104 +396,255 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
         &self.rls
     }
 
+    /// Base parameters of the model the controller uses now.
+    pub fn in_use(&self) -> BaseParameters<N, NP> {
+        BaseParameters { theta: self.in_use }
+    }
+
     /// Drops the identification's open window (see
     /// [`EnergyBalanceRls::restart_window`]).
     pub fn restart_window(&mut self) {
         self.rls.restart_window();
     }
 
-    /// Models swapped into the controller so far.
+    /// Models swapped into the controller so far (reverts not subtracted).
     pub fn model_updates(&self) -> usize {
         self.updates
+    }
+
+    /// Models the supervisor took back.
+    pub fn reverts(&self) -> usize {
+        self.reverts
+    }
+
+    /// Candidates refused so far, per reason (in [`Refusal::ALL`]'s order).
+    pub fn refusals(&self) -> [usize; 3] {
+        self.refusals
+    }
+
+    /// Candidates refused so far, all reasons.
+    pub fn refused(&self) -> usize {
+        self.refusals.iter().sum()
     }
 
     /// Estimates whose model or mode family could not be computed (the
     /// controller kept its model).
     pub fn failed_models(&self) -> usize {
-        self.failures
+        self.refusals[2]
     }
 
-    /// One sample, before or after the controller's step (the
-    /// `AdaptiveController` of the FMU calls it after, with the state the
-    /// step used): `(q, qd)` measured now, `tau` the torque applied since
-    /// the previous sample, `dt` ago. Feeds the identification; swaps a
-    /// ready model and family into `controller`; posts a new one when the
-    /// estimate has moved.
+    /// What the adaptation is doing.
+    pub fn status(&self) -> AdaptationStatus {
+        self.status
+    }
+
+    /// The latest event and its number (events are numbered from 1; a
+    /// caller logs those it has not seen).
+    pub fn last_event(&self) -> Option<(usize, AdaptationEvent)> {
+        self.last_event
+    }
+
+    fn event(&mut self, event: AdaptationEvent) {
+        self.events += 1;
+        self.last_event = Some((self.events, event));
+    }
+
+    fn refuse(&mut self, reason: Refusal) {
+        self.refusals[reason as usize] += 1;
+        self.event(AdaptationEvent::Refused(reason));
+    }
+
+    /// The torque the robot felt over the interval that ends at the state
+    /// measured now, from the commands: `command` was sent at the previous
+    /// sample, `dt` ago. The actuator's lag is integrated exactly for a
+    /// held command; the delay picks the interval (interpolated between
+    /// whole samples).
+    fn felt_torque(&mut self, command: &Vector<N>, dt: f64) -> Vector<N> {
+        let tc = self.options.actuator_time_constant;
+        let mean = if tc > 0.0 {
+            let decay = (-dt / tc).exp();
+            let mean = command + (self.actuator - command) * (tc / dt * (1.0 - decay));
+            self.actuator = command + (self.actuator - command) * decay;
+            mean
+        } else {
+            self.actuator = *command;
+            *command
+        };
+        self.felt.copy_within(0..MAX_DELAY_SAMPLES - 1, 1);
+        self.felt[0] = mean;
+        let delay = self.options.measurement_delay / dt;
+        let whole = (delay.floor() as usize).min(MAX_DELAY_SAMPLES - 2);
+        let part = (delay - whole as f64).clamp(0.0, 1.0);
+        self.felt[whole] * (1.0 - part) + self.felt[whole + 1] * part
+    }
+
+    /// One sample, after the controller's step (with the state the step
+    /// used, see the `AdaptiveController` of the FMU): `(q, qd)` measured
+    /// now, `command` the torque sent at the previous sample, `dt` ago.
+    /// Feeds the identification; scores, takes or refuses a candidate;
+    /// supervises a new model.
     pub fn sample(
         &mut self,
         controller: &mut Controller<PlanarChain<N>, N, NX>,
         q: &Vector<N>,
         qd: &Vector<N>,
-        tau: &Vector<N>,
+        command: &Vector<N>,
         dt: f64,
     ) {
-        self.rls.add_sample(q, qd, tau, dt);
+        let felt = self.felt_torque(command, dt);
+        let window = self.rls.add_sample(q, qd, &felt, dt);
         self.samples += 1;
+        self.observe(controller, q, qd, command);
+        if let Some(window) = window {
+            self.score(&window);
+        }
         if !self.samples.is_multiple_of(self.options.period) {
             return;
         }
-        let (lock, wake) = &*self.shared;
-        let mut slot = if self.options.synchronous {
-            let Ok(mut slot) = lock.lock() else { return };
-            while self.pending && !matches!(&slot.result, Some((g, _)) if *g == self.generation) {
-                if slot.result.is_some() {
-                    self.drop_stale(&mut slot);
-                }
-                slot = match wake.wait(slot) {
-                    Ok(s) => s,
-                    Err(_) => return,
-                };
-            }
-            slot
-        } else {
-            // Never wait in a real-time sample: a busy worker is looked at
-            // next period.
-            let Ok(slot) = lock.try_lock() else { return };
-            slot
-        };
-        if matches!(&slot.result, Some((g, _)) if *g != self.generation) {
-            self.drop_stale(&mut slot);
-        }
-        if let Some((_, result)) = slot.result.take() {
-            self.pending = false;
-            self.request = None;
-            // A failed model or family (or one this controller cannot
-            // take) leaves the model in use; a later estimate may succeed.
-            let replaced = result.map(|(model, family, substeps)| {
-                let old = controller.replace_model(model, family)?;
-                controller.set_substeps(substeps).map(|()| old)
-            });
-            match replaced {
-                Ok(Ok(old)) => {
-                    // Empty here: the worker frees the garbage before it
-                    // computes the next result, so this never drops a family.
-                    slot.garbage = old;
-                    self.in_use = self.posted;
-                    self.updates += 1;
-                    wake.notify_one();
-                }
-                _ => self.failures += 1,
-            }
-        }
-        if self.pending {
+        self.look(controller);
+    }
+
+    /// The closed loop's torque and energy error (under the model in use)
+    /// into the supervisor's blocks.
+    fn observe(
+        &mut self,
+        controller: &Controller<PlanarChain<N>, N, NX>,
+        q: &Vector<N>,
+        qd: &Vector<N>,
+        command: &Vector<N>,
+    ) {
+        if !(q.iter().chain(qd).chain(command).all(|v| v.is_finite())) {
             return;
         }
-        let estimate = self.rls.estimate();
-        // Relative change per parameter (a friction coefficient near zero
-        // against the prior's floor).
+        let energy = self
+            .in_use
+            .dot(&energy_features::<N, NP>(&self.prior, q, qd));
+        let e2 = (energy - controller.config().cost.e_ref).powi(2);
+        let t2 = command.norm_squared();
+        let judge = self.options.judge_samples;
+        self.recent.add(t2, e2);
+        if self.recent.samples >= judge {
+            self.recent_prev = std::mem::replace(&mut self.recent_done, self.recent);
+            self.recent = Block::default();
+        }
+        if let Phase::Supervising(watch) = &mut self.phase {
+            watch.samples += 1;
+            if watch.samples <= self.options.period {
+                watch.early.add(t2, e2);
+            }
+            let end = self.options.settle_samples + judge;
+            if watch.samples > end.saturating_sub(judge) {
+                watch.after.add(t2, e2);
+            }
+            watch.current.add(t2, e2);
+            if watch.current.samples >= self.options.period {
+                let (torque_before, _) = watch.before.rms();
+                let (torque, energy) = std::mem::take(&mut watch.current).rms();
+                let config = controller.config();
+                // A catastrophe is not waited out: a torque far above the
+                // steady loop's before the change while the energy error
+                // does not come down (a right model that finds the
+                // energy low brings it down by climbing), two periods in a
+                // row, is judged at the next look.
+                let bad = torque > 2.0 * torque_before + 0.1 * config.tau_max
+                    && energy >= 0.95 * watch.last_energy;
+                watch.strikes = if bad { watch.strikes + 1 } else { 0 };
+                watch.alarm |= watch.strikes >= 2;
+                watch.last_energy = energy;
+            }
+        }
+    }
+
+    /// A held-out window: the candidate formed before it is scored against
+    /// the model in use.
+    fn score(&mut self, window: &WindowEquation<NP>) {
+        if let Phase::Validating(candidate) = &mut self.phase {
+            if !(window.variance > 0.0 && window.y.is_finite()) {
+                return;
+            }
+            let delta = window.h.dot(&(candidate.theta - self.in_use));
+            candidate.score +=
+                window.normalised_error(&self.in_use) - window.normalised_error(&candidate.theta);
+            candidate.distinct += delta * delta / window.variance;
+            candidate.windows += 1;
+        }
+        if self.status == AdaptationStatus::Idle && window.used {
+            self.status = AdaptationStatus::Learning;
+        }
+    }
+
+    fn look(&mut self, controller: &mut Controller<PlanarChain<N>, N, NX>) {
+        match std::mem::replace(&mut self.phase, Phase::Watching) {
+            Phase::Watching => self.propose(controller),
+            Phase::Validating(candidate) => self.decide(controller, candidate),
+            Phase::Supervising(watch) => self.judge(controller, watch),
+        }
+    }
+
+    /// Makes a candidate of the estimate when it has moved: shortened to
+    /// the trust region, physical, not the model just reverted; posts its
+    /// model to the worker.
+    fn propose(&mut self, controller: &Controller<PlanarChain<N>, N, NX>) {
+        let estimate = self.rls.estimate().theta;
         let floor = self.options.rls.prior_floor;
-        let change = (0..NP)
-            .map(|i| (estimate.theta[i] - self.in_use[i]).abs() / (self.in_use[i].abs() + floor))
-            .fold(0.0, f64::max);
+        let relative = |a: &SVector<f64, NP>, b: &SVector<f64, NP>| {
+            (0..NP)
+                .map(|i| (a[i] - b[i]).abs() / (b[i].abs() + floor))
+                .fold(0.0, f64::max)
+        };
+        let change = relative(&estimate, &self.in_use);
         if change < self.options.min_change {
+            if self.rls.updates() > 0 && self.status != AdaptationStatus::Reverted {
+                self.status = AdaptationStatus::Converged;
+            }
             return;
         }
-        let Ok(params) = estimate.physical(&self.prior) else {
+        // Only a steady loop proposes: its energy error (under the model in
+        // use) in the 5 % band, or no longer falling. The supervisor then
+        // has a loop to compare with, and the climb's information is kept
+        // by the identification (a climb's windows cannot show a biased
+        // estimate, say by an undeclared delay, to be wrong).
+        let (torque, energy_error) = self.recent_done.rms();
+        let (_, energy_before) = self.recent_prev.rms();
+        let config = controller.config();
+        let steady = energy_error < 0.05 * config.cost.e_ref
+            || (energy_error > 0.9 * energy_before && torque < 0.5 * config.tau_max);
+        if self.recent_prev.samples == 0 || !steady || self.samples < self.hold_until {
+            return;
+        }
+        // The estimate must have moved significantly from the model in use
+        // (its Mahalanobis distance under the estimate's covariance beyond
+        // the 99 % quantile of chi^2 with NP degrees of freedom), not only
+        // by the noise of its windows.
+        let moved = estimate - self.in_use;
+        let significant = self
+            .rls
+            .covariance()
+            .cholesky()
+            .map(|c| moved.dot(&c.solve(&moved)))
+            .is_some_and(|d2| d2 > chi2_99(NP));
+        if !significant {
+            return;
+        }
+        let step = (self.options.trust_region / change).min(1.0);
+        let theta = BaseParameters::<N, NP> {
+            theta: self.in_use + (estimate - self.in_use) * step,
+        }
+        .projected()
+        .theta;
+        if let Some(reverted) = &self.reverted_theta
+            && relative(&theta, reverted) < 3.0 * self.options.min_change
+        {
+            return;
+        }
+        let Ok(params) = (BaseParameters::<N, NP> { theta }).physical(&self.prior) else {
+            self.refuse(Refusal::NotPhysical);
             return;
         };
         let family = match controller.family() {
             Some(family) => {
                 let Ok(chain) = PlanarChain::new(params) else {
+                    self.refuse(Refusal::NotPhysical);
                     return;
                 };
                 let mut options = if self.options.family_energy_max > 0.0 {
@@ -259,12 +662,221 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
             family,
             dt: controller.config().dt,
         };
+        let (lock, wake) = &*self.shared;
+        let Ok(mut slot) = lock.lock() else { return };
         // Copies of plain data: no allocation.
         slot.request = Some((self.generation, request.clone()));
-        self.request = Some(request);
-        self.posted = estimate.theta;
-        self.pending = true;
         wake.notify_one();
+        drop(slot);
+        if self.status != AdaptationStatus::Reverted {
+            self.status = AdaptationStatus::Learning;
+        }
+        self.phase = Phase::Validating(Candidate {
+            theta,
+            request,
+            score: 0.0,
+            distinct: 0.0,
+            windows: 0,
+        });
+    }
+
+    /// Takes the candidate once the held-out windows show it better and its
+    /// model is ready; refuses it when they do not.
+    fn decide(
+        &mut self,
+        controller: &mut Controller<PlanarChain<N>, N, NX>,
+        candidate: Candidate<N, NP>,
+    ) {
+        let o = &self.options;
+        // Better: the gain is at least a quarter of what a right candidate
+        // gains and three of its standard deviations (2 sqrt(distinct)).
+        let margin = (6.0 * candidate.distinct.sqrt()).max(0.25 * candidate.distinct);
+        // The two must also differ by three standard deviations on those
+        // windows: a candidate the windows cannot tell apart is not taken.
+        let better = candidate.windows >= o.min_validation_windows
+            && candidate.distinct >= 9.0
+            && candidate.score > margin;
+        let worse = candidate.windows >= o.min_validation_windows && candidate.score < -margin;
+        if !better && !worse && candidate.windows < o.max_validation_windows {
+            self.phase = Phase::Validating(candidate);
+            return;
+        }
+        if !better {
+            self.cancel();
+            self.refuse(Refusal::NotBetter);
+            return;
+        }
+        let Some(computed) = self.take_result() else {
+            // Still being computed: look again next period.
+            self.phase = Phase::Validating(candidate);
+            return;
+        };
+        let Ok((model, family, substeps)) = computed else {
+            self.refuse(Refusal::ModelFailed);
+            return;
+        };
+        let previous_model = *controller.system();
+        let previous_substeps = controller.config().substeps;
+        let previous_family = match controller.replace_model(model, family) {
+            Ok(old) => old,
+            Err(_) => {
+                self.refuse(Refusal::ModelFailed);
+                return;
+            }
+        };
+        if controller.set_substeps(substeps).is_err() {
+            // Put the model back (same family degree: cannot fail).
+            let _ = controller.replace_model(previous_model, previous_family);
+            self.refuse(Refusal::ModelFailed);
+            return;
+        }
+        self.updates += 1;
+        self.event(AdaptationEvent::Accepted {
+            improvement: candidate.score,
+            windows: candidate.windows,
+        });
+        self.reverted_theta = None;
+        self.phase = Phase::Supervising(Watch {
+            previous_theta: self.in_use,
+            previous_model,
+            previous_family,
+            previous_substeps,
+            before: self.recent_done,
+            early: Block::default(),
+            after: Block::default(),
+            current: Block::default(),
+            last_energy: 0.0,
+            strikes: 0,
+            alarm: false,
+            samples: 0,
+        });
+        self.in_use = candidate.theta;
+        self.status = AdaptationStatus::Learning;
+    }
+
+    /// At the end of a watch: keeps the new model, or brings the previous
+    /// one back when the closed loop does worse. Worse: once the energy is
+    /// in the 5 % band, a torque that rose; before, an energy error that
+    /// rose above both the one before the change and the one the new model
+    /// started from.
+    fn judge(&mut self, controller: &mut Controller<PlanarChain<N>, N, NX>, watch: Watch<N, NP>) {
+        if !watch.alarm && watch.samples < self.options.settle_samples + self.options.judge_samples
+        {
+            self.phase = Phase::Supervising(watch);
+            return;
+        }
+        let e_ref = controller.config().cost.e_ref;
+        let tau_max = controller.config().tau_max;
+        let (torque_before, energy_before) = watch.before.rms();
+        let (_, energy_early) = watch.early.rms();
+        let (torque_after, energy_after) = watch.after.rms();
+        let settled = |e: f64| e < 0.05 * e_ref;
+        let worse = watch.alarm
+            || if settled(energy_after) {
+                settled(energy_before) && torque_after > 1.2 * torque_before + 0.02 * tau_max
+            } else {
+                energy_after > 1.2 * energy_before.max(energy_early) + 0.01 * e_ref
+            };
+        let Watch {
+            previous_theta,
+            previous_model,
+            previous_family,
+            previous_substeps,
+            ..
+        } = watch;
+        if !worse {
+            self.discard_family(previous_family);
+            return;
+        }
+        match controller.replace_model(previous_model, previous_family) {
+            Ok(dropped) => {
+                let _ = controller.set_substeps(previous_substeps);
+                self.discard_family(dropped);
+                self.reverted_theta = Some(self.in_use);
+                self.in_use = previous_theta;
+                self.reverts += 1;
+                // Each revert doubles the wait before the next candidate.
+                let wait = (self.options.settle_samples + self.options.judge_samples)
+                    .saturating_mul(1 << self.reverts.min(16));
+                self.hold_until = self.samples.saturating_add(wait);
+                self.status = AdaptationStatus::Reverted;
+                self.event(AdaptationEvent::Reverted {
+                    torque_before,
+                    torque_after,
+                    energy_before,
+                    energy_after,
+                });
+            }
+            Err(_) => self.refuse(Refusal::ModelFailed),
+        }
+    }
+
+    /// The worker's answer for the current generation: waits for it when
+    /// `synchronous`, else takes it only if it is there.
+    fn take_result(&mut self) -> Option<Result<Computed<N>, ()>> {
+        let (lock, wake) = &*self.shared;
+        let mut slot = if self.options.synchronous {
+            // A candidate's request is always in flight (a restored state
+            // posts it again): its answer comes.
+            let Ok(mut slot) = lock.lock() else {
+                return None;
+            };
+            while !matches!(&slot.result, Some((g, _)) if *g == self.generation) {
+                if slot.result.is_some() {
+                    self.drop_stale(&mut slot);
+                }
+                slot = match wake.wait(slot) {
+                    Ok(s) => s,
+                    Err(_) => return None,
+                };
+            }
+            slot
+        } else {
+            // Never wait in a real-time sample: a busy worker is looked at
+            // next period.
+            let Ok(slot) = lock.try_lock() else {
+                return None;
+            };
+            slot
+        };
+        if matches!(&slot.result, Some((g, _)) if *g != self.generation) {
+            self.drop_stale(&mut slot);
+        }
+        slot.result.take().map(|(_, result)| result)
+    }
+
+    /// Forgets the candidate's request: its answer, when it comes, is of an
+    /// old generation and freed as stale.
+    fn cancel(&mut self) {
+        self.generation += 1;
+        let (lock, _) = &*self.shared;
+        if let Ok(mut slot) = lock.try_lock() {
+            slot.request = None;
+            if slot.result.is_some() {
+                self.drop_stale(&mut slot);
+            }
+        }
+    }
+
+    /// Hands a family to the worker to free (dropped here only when the
+    /// worker still has one to free: rare, and never in a real-time loop's
+    /// steady state).
+    fn discard_family(&self, family: Option<ChartFamily<N>>) {
+        if family.is_none() {
+            return;
+        }
+        let (lock, wake) = &*self.shared;
+        let slot = if self.options.synchronous {
+            lock.lock().ok()
+        } else {
+            lock.try_lock().ok()
+        };
+        if let Some(mut slot) = slot
+            && slot.garbage.is_none()
+        {
+            slot.garbage = family;
+            wake.notify_one();
+        }
     }
 }
 
@@ -274,17 +886,26 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
 pub struct AdaptationState<const N: usize, const NP: usize> {
     rls: EnergyBalanceRls<N, NP>,
     in_use: SVector<f64, NP>,
-    posted: SVector<f64, NP>,
-    /// The request the worker was computing (posted again on restore).
-    request: Option<Request<N>>,
-    failures: usize,
+    phase: Phase<N, NP>,
+    reverted_theta: Option<SVector<f64, NP>>,
+    felt: Vec<Vector<N>>,
+    actuator: Vector<N>,
+    recent: Block,
+    recent_done: Block,
+    recent_prev: Block,
     samples: usize,
+    hold_until: usize,
     updates: usize,
+    reverts: usize,
+    refusals: [usize; 3],
+    last_event: Option<(usize, AdaptationEvent)>,
+    events: usize,
+    status: AdaptationStatus,
 }
 
 impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
-    /// A stale answer (of a generation before a restore) goes to the
-    /// worker's garbage, or is dropped when that is taken.
+    /// A stale answer (of a generation before a restore or a refusal) goes
+    /// to the worker's garbage, or is dropped when that is taken.
     fn drop_stale(&self, slot: &mut Slot<N>) {
         if let Some((_, Ok((_, family @ Some(_), _)))) = slot.result.take()
             && slot.garbage.is_none()
@@ -294,45 +915,66 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
     }
 
     /// Everything the next samples depend on: the identification, the
-    /// model in use and a request in flight. With `synchronous` (offline
-    /// simulation), a restored adaptation continues bit for bit.
+    /// model in use, a candidate (its request is posted again on restore)
+    /// and a model under watch. With `synchronous` (offline simulation), a
+    /// restored adaptation continues bit for bit.
     pub fn save_state(&self) -> AdaptationState<N, NP> {
         AdaptationState {
             rls: self.rls.clone(),
             in_use: self.in_use,
-            posted: self.posted,
-            request: if self.pending {
-                self.request.clone()
-            } else {
-                None
-            },
-            failures: self.failures,
+            phase: self.phase.clone(),
+            reverted_theta: self.reverted_theta,
+            felt: self.felt.to_vec(),
+            actuator: self.actuator,
+            recent: self.recent,
+            recent_done: self.recent_done,
+            recent_prev: self.recent_prev,
             samples: self.samples,
+            hold_until: self.hold_until,
             updates: self.updates,
+            reverts: self.reverts,
+            refusals: self.refusals,
+            last_event: self.last_event,
+            events: self.events,
+            status: self.status,
         }
     }
 
     /// Continues from `state` (saved by an adaptation with the same
-    /// prior and options): a request in flight is posted again, answers
+    /// prior and options): a candidate's request is posted again, answers
     /// the worker is still computing for the state before are dropped.
     pub fn restore_state(&mut self, state: AdaptationState<N, NP>) -> Result<(), IdentifyError> {
         self.rls.check_compatible(&state.rls)?;
+        if state.felt.len() != MAX_DELAY_SAMPLES {
+            return Err(IdentifyError::NotPhysical(
+                "the saved torque history has another length".into(),
+            ));
+        }
         let (lock, wake) = &*self.shared;
         let mut slot = lock.lock().unwrap_or_else(|e| e.into_inner());
         self.generation += 1;
-        slot.request = state
-            .request
-            .clone()
-            .map(|request| (self.generation, request));
+        slot.request = match &state.phase {
+            Phase::Validating(candidate) => Some((self.generation, candidate.request.clone())),
+            _ => None,
+        };
         slot.result = None;
-        self.pending = state.request.is_some();
-        self.request = state.request;
         self.rls = state.rls;
         self.in_use = state.in_use;
-        self.posted = state.posted;
-        self.failures = state.failures;
+        self.phase = state.phase;
+        self.reverted_theta = state.reverted_theta;
+        self.felt.copy_from_slice(&state.felt);
+        self.actuator = state.actuator;
+        self.recent = state.recent;
+        self.recent_done = state.recent_done;
+        self.recent_prev = state.recent_prev;
         self.samples = state.samples;
+        self.hold_until = state.hold_until;
         self.updates = state.updates;
+        self.reverts = state.reverts;
+        self.refusals = state.refusals;
+        self.last_event = state.last_event;
+        self.events = state.events;
+        self.status = state.status;
         wake.notify_all();
         Ok(())
     }
@@ -349,6 +991,14 @@ impl<const N: usize, const NX: usize, const NP: usize> Drop for Adaptation<N, NX
             let _ = worker.join();
         }
     }
+}
+
+/// The 99 % quantile of chi^2 with `k` degrees of freedom
+/// (Wilson-Hilferty, within 1 % for `k >= 3`).
+fn chi2_99(k: usize) -> f64 {
+    let k = k as f64;
+    let a = 2.0 / (9.0 * k);
+    k * (1.0 - a + 2.326_347_874 * a.sqrt()).powi(3)
 }
 
 /// The worker: computes requested models and families, frees garbage.

@@ -132,6 +132,17 @@ impl<const N: usize, const NP: usize> BaseParameters<N, NP> {
         self.theta[Self::coulomb_index(j)]
     }
 
+    /// The nearest parameters whose rotor inertias and friction
+    /// coefficients are not negative (an unconstrained estimate of a
+    /// frictionless joint scatters around zero).
+    pub fn projected(&self) -> Self {
+        let mut theta = self.theta;
+        for v in theta.iter_mut().skip(Self::rotor_index(0)) {
+            *v = v.max(0.0);
+        }
+        Self { theta }
+    }
+
     /// The base parameters of a chain (refused: joint springs).
     pub fn of(params: &PlanarChainParams<N>) -> Result<Self, IdentifyError> {
         let () = Self::CHECK;
@@ -296,12 +307,19 @@ pub struct RlsOptions {
     pub prior_floor: f64,
     /// Samples per window.
     pub window: usize,
-    /// Standard deviation of one window's equation error (J): integration
-    /// error of the work and friction integrals, measurement noise.
+    /// Samples averaged at each end of a window (`1..=window`): the
+    /// balance holds at every sample, so averaging its ends is exact for
+    /// the model and divides the measurement noise of the ends by this.
+    pub end_samples: usize,
+    /// Smallest standard deviation of one window's equation error (J): the
+    /// integration error of the work and friction integrals. The error the
+    /// measurements add is estimated online ([`EnergyBalanceRls::noise`]).
     pub equation_noise: f64,
-    /// A window whose information `h' P h / equation_noise^2` is below this
-    /// is skipped (not exciting).
+    /// A window whose information `h' P h / R` (`R` its error variance) is
+    /// below this is skipped (not exciting).
     pub min_information: f64,
+    /// Samples over which the measurement noise estimate averages.
+    pub noise_memory: usize,
 }
 
 impl Default for RlsOptions {
@@ -311,15 +329,152 @@ impl Default for RlsOptions {
             prior_relative: 0.5,
             prior_floor: 0.05,
             window: 20,
+            end_samples: 5,
             equation_noise: 1e-3,
             min_information: 1e-4,
+            noise_memory: 1200,
         }
     }
 }
 
+impl RlsOptions {
+    /// Checks the settings; the message names the offending one.
+    pub fn validate(&self) -> Result<(), IdentifyError> {
+        let bad = |what: String| Err(IdentifyError::NotPhysical(what));
+        if !(self.forgetting > 0.0 && self.forgetting <= 1.0) {
+            return bad(format!(
+                "forgetting = {} must be in (0, 1]",
+                self.forgetting
+            ));
+        }
+        for (name, v) in [
+            ("prior_relative", self.prior_relative),
+            ("prior_floor", self.prior_floor),
+            ("equation_noise", self.equation_noise),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return bad(format!("{name} = {v} must be finite and > 0"));
+            }
+        }
+        if !(self.min_information.is_finite() && self.min_information >= 0.0) {
+            return bad(format!(
+                "min_information = {} must be finite and >= 0",
+                self.min_information
+            ));
+        }
+        if self.window == 0 || self.end_samples == 0 || self.end_samples > self.window {
+            return bad(format!(
+                "window = {} and end_samples = {} must satisfy 1 <= end_samples <= window",
+                self.window, self.end_samples
+            ));
+        }
+        if self.noise_memory == 0 {
+            return bad("noise_memory must be >= 1".into());
+        }
+        Ok(())
+    }
+}
+
+/// One window's energy balance `h' theta = y`, with the variance `R` of
+/// its error (J^2) as the measurements make it.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct WindowEquation<const NP: usize> {
+    /// Change of the energy features plus the friction integrals.
+    pub h: SVector<f64, NP>,
+    /// Work of the applied torque (J).
+    pub y: f64,
+    /// Variance of the equation error (J^2).
+    pub variance: f64,
+    /// Whether it updated the estimate (else: not exciting enough, or not
+    /// finite).
+    pub used: bool,
+}
+
+impl<const NP: usize> WindowEquation<NP> {
+    /// The squared error of `theta` on this window in units of its
+    /// variance.
+    pub fn normalised_error(&self, theta: &SVector<f64, NP>) -> f64 {
+        (self.y - self.h.dot(theta)).powi(2) / self.variance
+    }
+}
+
+/// Online estimate of the measurement noise in the energy balance, from
+/// the second and third differences of the balance's running residual
+/// `r_k = theta' Phi_k - W_k` (constant for the true parameters): white
+/// noise of the measured state gives `r` white noise (variance `level`),
+/// noise of the applied torque a random walk (`walk` per sample). The
+/// smooth motion hardly enters differences of this order at the sample
+/// rate.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+struct NoiseEstimate {
+    /// The last two residual increments.
+    increments: [f64; 2],
+    /// Increments seen since the last gap (up to 3 matter).
+    seen: usize,
+    /// Running means of the squared second and third differences of `r`.
+    second: f64,
+    third: f64,
+    /// Samples in the running means (up to the memory).
+    count: usize,
+}
+
+impl NoiseEstimate {
+    fn new() -> Self {
+        Self {
+            increments: [0.0; 2],
+            seen: 0,
+            second: 0.0,
+            third: 0.0,
+            count: 0,
+        }
+    }
+
+    fn gap(&mut self) {
+        self.seen = 0;
+    }
+
+    fn add(&mut self, increment: f64, memory: usize) {
+        if !increment.is_finite() {
+            self.seen = 0;
+            return;
+        }
+        let [d1, d2] = self.increments;
+        self.increments = [increment, d1];
+        self.seen += 1;
+        if self.seen < 3 {
+            return;
+        }
+        let second = increment - d1;
+        let third = increment - 2.0 * d1 + d2;
+        self.count = (self.count + 1).min(memory);
+        let w = 1.0 / self.count as f64;
+        self.second += w * (second * second - self.second);
+        self.third += w * (third * third - self.third);
+    }
+
+    /// `(level, walk)`: the variance of the white noise on `r` and of the
+    /// random walk's steps. Second differences: `6 level + 2 walk`, third:
+    /// `20 level + 6 walk`.
+    fn variances(&self) -> (f64, f64) {
+        if self.count < 10 {
+            return (0.0, 0.0);
+        }
+        let level = ((self.third - 3.0 * self.second) / 2.0).max(0.0);
+        let walk = ((self.second - 6.0 * level) / 2.0).max(0.0);
+        (level, walk)
+    }
+}
+
 /// Energy-balance identification by recursive least squares, fed one
-/// sample at a time (measured `q`, `qd` and the torque applied over the
+/// sample at a time (the state `q`, `qd` and the torque applied over the
 /// previous sample); fixed size, no allocation.
+///
+/// Each window's equation is weighted by the variance the measurements give
+/// it (estimated online, [`EnergyBalanceRls::noise`]): noisy sensors make
+/// the estimate move slowly instead of chasing the noise. The estimate is
+/// the unconstrained least-squares one (the information of every window is
+/// kept); a model is made of it only through
+/// [`BaseParameters::physical`].
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct EnergyBalanceRls<const N: usize, const NP: usize> {
     prior: PlanarChainParams<N>,
@@ -328,26 +483,34 @@ pub struct EnergyBalanceRls<const N: usize, const NP: usize> {
     covariance: SMatrix<f64, NP, NP>,
     /// Largest diagonal of the covariance: its prior (bounds windup).
     covariance_bound: SVector<f64, NP>,
-    /// Window: features at its start, integrals so far, samples in it.
-    start: SVector<f64, NP>,
-    friction_integral: SVector<f64, NP>,
-    work_integral: f64,
-    samples: usize,
-    last: Option<(Vector<N>, Vector<N>, Vector<N>)>,
+    /// Running energy-balance sums since the anchor: features plus friction
+    /// integrals, and work.
+    features: SVector<f64, NP>,
+    work: f64,
+    /// Sums over the current end block of the window.
+    block_features: SVector<f64, NP>,
+    block_work: f64,
+    /// The previous block's average, relative to the anchor (None: the
+    /// first block after a gap is still open).
+    anchor: Option<(SVector<f64, NP>, f64)>,
+    /// Samples since the last gap.
+    position: usize,
+    /// The previous sample: state, and its energy features.
+    last: Option<(Vector<N>, Vector<N>, SVector<f64, NP>)>,
+    noise: NoiseEstimate,
     updates: usize,
+    skipped: usize,
 }
 
 impl<const N: usize, const NP: usize> EnergyBalanceRls<N, NP> {
     /// Starts at the prior chain's base parameters.
     pub fn new(prior: &PlanarChainParams<N>, options: RlsOptions) -> Result<Self, IdentifyError> {
+        options.validate()?;
         let theta = BaseParameters::<N, NP>::of(prior)?.theta;
-        // In units of the equation noise: the RLS gain is then P h / (lambda + h' P h).
-        let noise2 = options.equation_noise.powi(2);
         let variance = theta.map(|v| {
             (options.prior_relative * v.abs())
                 .max(options.prior_floor)
                 .powi(2)
-                / noise2
         });
         Ok(Self {
             prior: *prior,
@@ -355,20 +518,72 @@ impl<const N: usize, const NP: usize> EnergyBalanceRls<N, NP> {
             estimate: theta,
             covariance: SMatrix::from_diagonal(&variance),
             covariance_bound: variance,
-            start: SVector::zeros(),
-            friction_integral: SVector::zeros(),
-            work_integral: 0.0,
-            samples: 0,
+            features: SVector::zeros(),
+            work: 0.0,
+            block_features: SVector::zeros(),
+            block_work: 0.0,
+            anchor: None,
+            position: 0,
             last: None,
+            noise: NoiseEstimate::new(),
             updates: 0,
+            skipped: 0,
         })
     }
 
-    /// The current estimate.
+    /// The current estimate (unconstrained: see
+    /// [`BaseParameters::physical`]).
     pub fn estimate(&self) -> BaseParameters<N, NP> {
         BaseParameters {
             theta: self.estimate,
         }
+    }
+
+    /// The estimate's covariance (base parameters squared).
+    pub fn covariance(&self) -> &SMatrix<f64, NP, NP> {
+        &self.covariance
+    }
+
+    /// The settings.
+    pub fn options(&self) -> &RlsOptions {
+        &self.options
+    }
+
+    /// Relative standard deviation of the estimate's scale: of `s` in
+    /// `theta_E = s theta_E,estimate` over the inertia and gravity
+    /// amplitudes and rotor inertias. Free motion gives their ratios; only
+    /// work done on the robot gives this.
+    pub fn scale_uncertainty(&self) -> f64 {
+        let energy = NP - 2 * N;
+        let mut num = 0.0;
+        let mut den = 0.0;
+        for i in 0..energy {
+            for k in 0..energy {
+                num += self.estimate[i] * self.covariance[(i, k)] * self.estimate[k];
+            }
+            den += self.estimate[i] * self.estimate[i];
+        }
+        if den > 0.0 {
+            num.max(0.0).sqrt() / den
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// Standard deviations of the measurement noise in the energy balance:
+    /// the white part (J) and the random walk's per-sample step (J, e.g.
+    /// noise of the applied torque).
+    pub fn noise(&self) -> (f64, f64) {
+        let (level, walk) = self.noise.variances();
+        (level.sqrt(), walk.sqrt())
+    }
+
+    /// Variance of one window's equation error (J^2): the integration floor
+    /// plus what the estimated measurement noise gives a window.
+    pub fn window_variance(&self) -> f64 {
+        let (level, walk) = self.noise.variances();
+        let o = &self.options;
+        o.equation_noise.powi(2) + 2.0 * level / o.end_samples as f64 + walk * o.window as f64
     }
 
     /// Whether `saved` (a saved state) belongs to an identification with
@@ -400,61 +615,102 @@ impl<const N: usize, const NP: usize> EnergyBalanceRls<N, NP> {
         self.updates
     }
 
+    /// Windows skipped so far (too little information, or not finite).
+    pub fn skipped(&self) -> usize {
+        self.skipped
+    }
+
     /// One sample: the state `(q, qd)` now and the torque `tau` applied
-    /// since the previous sample, `dt` seconds ago. Returns whether a
-    /// window closed and updated the estimate.
-    pub fn add_sample(&mut self, q: &Vector<N>, qd: &Vector<N>, tau: &Vector<N>, dt: f64) -> bool {
+    /// since the previous sample, `dt` seconds ago. Returns the window's
+    /// equation when one closed (updating the estimate when it carries
+    /// information).
+    pub fn add_sample(
+        &mut self,
+        q: &Vector<N>,
+        qd: &Vector<N>,
+        tau: &Vector<N>,
+        dt: f64,
+    ) -> Option<WindowEquation<NP>> {
         if !(q.iter().chain(qd).chain(tau).all(|v| v.is_finite()) && dt > 0.0) {
             // A gap: start a new window at the next good sample.
             self.last = None;
-            return false;
+            return None;
         }
-        let Some((q_prev, qd_prev, _)) = self.last else {
-            self.last = Some((*q, *qd, *tau));
-            self.start = energy_features::<N, NP>(&self.prior, q, qd);
-            self.friction_integral.fill(0.0);
-            self.work_integral = 0.0;
-            self.samples = 0;
-            return false;
+        let phi = energy_features::<N, NP>(&self.prior, q, qd);
+        let Some((q_prev, qd_prev, phi_prev)) = self.last else {
+            self.last = Some((*q, *qd, phi));
+            self.features.fill(0.0);
+            self.work = 0.0;
+            self.block_features.fill(0.0);
+            self.block_work = 0.0;
+            self.anchor = None;
+            self.position = 0;
+            self.noise.gap();
+            return self.close_block_if_due();
         };
         // The torque is held over the sample: its work is exactly
         // tau' (q - q_prev); the friction power by the trapezoid rule.
         let fp = friction_features::<N, NP>(&self.prior, &qd_prev);
         let fc = friction_features::<N, NP>(&self.prior, qd);
-        self.friction_integral += (fp + fc) * (0.5 * dt);
-        self.work_integral += tau.dot(&(q - q_prev));
-        self.samples += 1;
-        self.last = Some((*q, *qd, *tau));
-        if self.samples < self.options.window {
-            return false;
-        }
-        let end = energy_features::<N, NP>(&self.prior, q, qd);
-        let h = end - self.start + self.friction_integral;
-        let y = self.work_integral;
-        self.start = end;
-        self.friction_integral.fill(0.0);
-        self.work_integral = 0.0;
-        self.samples = 0;
-        self.update(&h, y)
+        let d_features = phi - phi_prev + (fp + fc) * (0.5 * dt);
+        let d_work = tau.dot(&(q - q_prev));
+        self.features += d_features;
+        self.work += d_work;
+        self.noise.add(
+            self.estimate.dot(&d_features) - d_work,
+            self.options.noise_memory,
+        );
+        self.last = Some((*q, *qd, phi));
+        self.position += 1;
+        self.close_block_if_due()
     }
 
-    fn update(&mut self, h: &SVector<f64, NP>, y: f64) -> bool {
+    /// Adds the sample to the end block when it is in one; at a block's
+    /// end, closes the window it ends (if any) and makes it the anchor.
+    fn close_block_if_due(&mut self) -> Option<WindowEquation<NP>> {
+        let (w, m) = (self.options.window, self.options.end_samples);
+        // Blocks end at positions m - 1 + i w and hold m samples.
+        let k = self.position as i64 - (m as i64 - 1);
+        let phase = k.rem_euclid(w as i64) as usize;
+        if !(phase == 0 || phase > w - m) {
+            return None;
+        }
+        self.block_features += self.features;
+        self.block_work += self.work;
+        if phase != 0 || k < 0 {
+            return None;
+        }
+        let average = (self.block_features / m as f64, self.block_work / m as f64);
+        self.block_features.fill(0.0);
+        self.block_work = 0.0;
+        // Rebase the running sums on this block (small numbers forever).
+        self.features -= average.0;
+        self.work -= average.1;
+        let anchor = self.anchor.replace((SVector::zeros(), 0.0));
+        let (start_features, start_work) = anchor?;
+        let h = average.0 - start_features;
+        let y = average.1 - start_work;
+        let variance = self.window_variance();
+        let used = self.update(&h, y, variance);
+        Some(WindowEquation {
+            h,
+            y,
+            variance,
+            used,
+        })
+    }
+
+    fn update(&mut self, h: &SVector<f64, NP>, y: f64, variance: f64) -> bool {
         let lambda = self.options.forgetting;
         let ph = self.covariance * h;
-        let information = h.dot(&ph);
-        if !(information.is_finite() && information >= self.options.min_information) {
-            return false;
-        }
-        let gain = ph / (lambda + information);
-        let candidate = self.estimate + gain * (y - h.dot(&self.estimate));
-        if (BaseParameters::<N, NP> { theta: candidate })
-            .physical(&self.prior)
-            .is_err()
+        let information = h.dot(&ph) / variance;
+        if !(information.is_finite() && y.is_finite()) || information < self.options.min_information
         {
-            // Projection: an update leaving the physical set is refused.
+            self.skipped += 1;
             return false;
         }
-        self.estimate = candidate;
+        let gain = ph / (lambda * variance + h.dot(&ph));
+        self.estimate += gain * (y - h.dot(&self.estimate));
         let mut p = (self.covariance - gain * ph.transpose()) / lambda;
         // Bounded covariance: forgetting does not wind up directions that
         // receive no information.

@@ -80,7 +80,7 @@ fn closed_loop(adapt: bool, seconds: f64) -> Outcome {
 
 #[test]
 fn adaptation_finds_the_plants_mode_and_energy() {
-    let on = closed_loop(true, 60.0);
+    let on = closed_loop(true, 90.0);
     eprintln!(
         "adapt on: E {:.4} J, tau {:?}, damping {:?}, distance {:.4}, {} models",
         on.mean_energy, on.rms_torque, on.rms_damping, on.rms_distance, on.model_updates
@@ -91,7 +91,7 @@ fn adaptation_finds_the_plants_mode_and_energy() {
     }
     assert!(on.rms_distance < 0.01);
     assert!(on.model_updates > 0);
-    let off = closed_loop(false, 60.0);
+    let off = closed_loop(false, 90.0);
     eprintln!(
         "adapt off: E {:.4} J, distance {:.4}",
         off.mean_energy, off.rms_distance
