@@ -1,6 +1,11 @@
 //! The EigenMPC running costs (paper, eqs. 10 and 12) in least-squares form
 //! `l = w_E r_E^2 + w_x |r_x|^2 + w_xd |r_xd|^2 + w_F |r_F|^2`, their exact
 //! residual Jacobians and the Gauss-Newton Hessian blocks they give.
+//!
+//! The energy residual is scaled by `sqrt(E_s / E_ref)` by default
+//! ([`CostParams::energy_scale`]): the paper's `r_E = E_ref - E` values a
+//! joule gained at a given fraction of the climb in proportion to `E_ref`,
+//! so its weights, tuned at 14 J, pull towards 3 J with a fifth of that.
 
 use super::Variant;
 use crate::mechanics::{Matrix, MechanicalSystem, Vector, unpack_state};
@@ -106,6 +111,11 @@ impl<const N: usize> Reference<N> {
     }
 }
 
+/// The energy at which the paper tuned `w_E` (its `E_ref`, section V-A):
+/// the default [`CostParams::energy_scale`], at which the scaled energy
+/// residual is exactly the paper's.
+pub const PAPER_ENERGY_SCALE: f64 = 14.0;
+
 /// Tunable cost parameters (may change between samples).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CostParams {
@@ -117,17 +127,42 @@ pub struct CostParams {
     pub beta: f64,
     /// Residual weights.
     pub weights: Weights,
+    /// Energy scale `E_s` (J) of the energy residual
+    /// `r_E = (E_ref - E) sqrt(E_s / E_ref)`, i.e. the energy cost
+    /// `w_E E_s E_ref (1 - E/E_ref)^2`. What the energy term trades against
+    /// the torque is the value of a joule gained, `dl/dE =
+    /// -2 w_E E_s (1 - E/E_ref)`: with this scale it depends on the
+    /// fraction of the climb only, and is at every `E_ref` what it is at
+    /// `E_ref = E_s`, where the residual is the paper's exactly (default
+    /// [`PAPER_ENERGY_SCALE`], where `w_E` was tuned). 0: the paper's
+    /// `r_E = E_ref - E` (and what a saved state without this field
+    /// computed), whose value of a joule grows with `E_ref`: a low
+    /// `E_ref` is approached slowly. With `E_s > 0`, `E_ref` must be > 0.
+    #[serde(default)]
+    pub energy_scale: f64,
     /// Penalise the torque beyond the model's friction, `tau - tau_f(qd)`,
     /// instead of `tau` (no effect on a frictionless model).
     pub compensate_friction: bool,
 }
 
+impl CostParams {
+    /// The factor `k = sqrt(E_s / E_ref)` of the energy residual (1 with
+    /// the paper's residual, `energy_scale = 0`; exactly 1 at `E_ref = E_s`).
+    pub fn energy_residual_factor(&self) -> f64 {
+        if self.energy_scale > 0.0 {
+            (self.energy_scale / self.e_ref).sqrt()
+        } else {
+            1.0
+        }
+    }
+}
+
 /// Residuals of one stage and their Jacobians w.r.t. `z = (q, qd)` and `tau`.
 #[derive(Clone, Copy, Debug)]
 pub struct Residuals<const N: usize, const NX: usize> {
-    /// `E_ref - E`.
+    /// `(E_ref - E) k`, `k` = [`CostParams::energy_residual_factor`].
     pub energy: f64,
-    /// `d(E_ref - E)/dz`.
+    /// `d r_E / dz = -k dE/dz`.
     pub energy_z: SVector<f64, NX>,
     /// Position distance `r_x`.
     pub position: Vector<N>,
@@ -175,9 +210,12 @@ where
     } else {
         (*tau, SMatrix::zeros())
     };
+    // k = 1 exactly at the paper's set-up (E_ref = E_s, or E_s = 0), so
+    // the paper's runs are unchanged to the last bit.
+    let k = params.energy_residual_factor();
     let mut r = Residuals {
-        energy: params.e_ref - energy,
-        energy_z: -grad_e,
+        energy: (params.e_ref - energy) * k,
+        energy_z: -grad_e * k,
         position: Vector::<N>::zeros(),
         position_z: SMatrix::zeros(),
         velocity: Vector::<N>::zeros(),

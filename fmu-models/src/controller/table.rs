@@ -237,6 +237,19 @@ pub fn table<const N: usize>() -> Table<Settings<N>> {
     rows.extend(computed_reference_rows::<N>());
     rows.extend(estimator_rows::<N>());
     rows.extend(adaptation_rows::<N>());
+    rows.push(
+        tunable(
+            "E_scale",
+            |s, _| s.tuning.e_scale,
+            |s, _, v| s.tuning.e_scale = v,
+            (0.0, 1e4),
+            "energy scale E_s of the energy residual r_E = (E_ref - E) sqrt(E_s/E_ref): every \
+             E_ref is pulled towards as E_ref = E_s is, where r_E is the paper's (default 14 J, \
+             the energy w_E was tuned at); **0 = the paper's E_ref - E** (a low E_ref is then \
+             approached slowly); with E_s > 0, E_ref must be > 0",
+        )
+        .unit("J"),
+    );
     Table::new(N, rows)
 }
 
