@@ -96,10 +96,10 @@ pub struct EigenMpcConfig {
     /// model (real-time loops); 0 (default) = the next look waits for it
     /// (reproducible offline runs). As the FMU's `adapt_realtime`.
     pub adapt_realtime: i32,
-    /// Energy scale E_s (J) of the energy residual r_E = (E_ref - E)
-    /// sqrt(E_s / E_ref), >= 0 (default 14, where w_E was tuned; 0: the
-    /// paper's E_ref - E). As the FMU's `E_scale`; last, so that the
-    /// offsets of the fields before it stay.
+    /// Energy scale E_s (J), >= 0: for E_ref < E_s the energy residual is
+    /// r_E = (E_ref - E) sqrt(E_s / E_ref) (default 14, where w_E was tuned;
+    /// from E_s up, and with 0, the paper's E_ref - E). As the FMU's
+    /// `E_scale`; last, so that the offsets of the fields before it stay.
     pub e_scale: f64,
 }
 

@@ -68,9 +68,9 @@ pub struct MpcConfig {
 impl MpcConfig {
     /// The paper's setting (section V-A): N = 80, dt = 25 ms, |tau| <= 1 N m,
     /// w_x = 50, w_xd = 2500, w_F = 225, w_E = 25 (curved) / 5 (straight),
-    /// alpha = beta = 0.1, E_ref = 14 J; the energy residual scaled by
-    /// sqrt(14 J / E_ref) ([`CostParams::energy_scale`]), which at
-    /// E_ref = 14 J is the paper's residual exactly.
+    /// alpha = beta = 0.1, E_ref = 14 J; below 14 J the energy residual
+    /// scaled by sqrt(14 J / E_ref) ([`CostParams::energy_scale`]), from
+    /// 14 J up the paper's residual exactly.
     pub fn paper(variant: Variant) -> Self {
         Self {
             horizon: 80,

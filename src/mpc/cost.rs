@@ -2,10 +2,11 @@
 //! `l = w_E r_E^2 + w_x |r_x|^2 + w_xd |r_xd|^2 + w_F |r_F|^2`, their exact
 //! residual Jacobians and the Gauss-Newton Hessian blocks they give.
 //!
-//! The energy residual is scaled by `sqrt(E_s / E_ref)` by default
-//! ([`CostParams::energy_scale`]): the paper's `r_E = E_ref - E` values a
-//! joule gained at a given fraction of the climb in proportion to `E_ref`,
-//! so its weights, tuned at 14 J, pull towards 3 J with a fifth of that.
+//! Below the energy scale `E_s` the energy residual is scaled by
+//! `sqrt(E_s / E_ref)` ([`CostParams::energy_scale`]): the paper's
+//! `r_E = E_ref - E` values a joule gained at a given fraction of the climb
+//! in proportion to `E_ref`, so its weights, tuned at 14 J, pull towards
+//! 3 J with a fifth of that.
 
 use super::Variant;
 use crate::mechanics::{Matrix, MechanicalSystem, Vector, unpack_state};
@@ -127,17 +128,19 @@ pub struct CostParams {
     pub beta: f64,
     /// Residual weights.
     pub weights: Weights,
-    /// Energy scale `E_s` (J) of the energy residual
-    /// `r_E = (E_ref - E) sqrt(E_s / E_ref)`, i.e. the energy cost
-    /// `w_E E_s E_ref (1 - E/E_ref)^2`. What the energy term trades against
-    /// the torque is the value of a joule gained, `dl/dE =
-    /// -2 w_E E_s (1 - E/E_ref)`: with this scale it depends on the
-    /// fraction of the climb only, and is at every `E_ref` what it is at
-    /// `E_ref = E_s`, where the residual is the paper's exactly (default
-    /// [`PAPER_ENERGY_SCALE`], where `w_E` was tuned). 0: the paper's
-    /// `r_E = E_ref - E` (and what a saved state without this field
-    /// computed), whose value of a joule grows with `E_ref`: a low
-    /// `E_ref` is approached slowly. With `E_s > 0`, `E_ref` must be > 0.
+    /// Energy scale `E_s` (J): below it the energy residual is
+    /// `r_E = (E_ref - E) sqrt(E_s / E_ref)`, from it up the paper's
+    /// `E_ref - E`. What the energy term trades against the torque is the
+    /// value of a joule gained, `d(w_E r_E^2)/dE`: with the paper's residual
+    /// `-2 w_E E_ref (1 - E/E_ref)`, which at a low `E_ref` is a fraction of
+    /// what `w_E` was tuned for, so a low `E_ref` is approached slowly.
+    /// Scaled, it is `-2 w_E E_s (1 - E/E_ref)`: the same function of the
+    /// climb's progress as at `E_ref = E_s`. The scale only lifts: it never
+    /// pulls less than the paper's residual, and at and above `E_s` (default
+    /// [`PAPER_ENERGY_SCALE`], where `w_E` was tuned) the residual is the
+    /// paper's exactly. 0: the paper's residual at every `E_ref` (and what
+    /// a saved state without this field computed). With `E_s > 0`, `E_ref`
+    /// must be > 0.
     #[serde(default)]
     pub energy_scale: f64,
     /// Penalise the torque beyond the model's friction, `tau - tau_f(qd)`,
@@ -146,10 +149,10 @@ pub struct CostParams {
 }
 
 impl CostParams {
-    /// The factor `k = sqrt(E_s / E_ref)` of the energy residual (1 with
-    /// the paper's residual, `energy_scale = 0`; exactly 1 at `E_ref = E_s`).
+    /// The factor `k` of the energy residual: `sqrt(E_s / E_ref)` below
+    /// `E_s`, exactly 1 from `E_s` up (so also with `energy_scale = 0`).
     pub fn energy_residual_factor(&self) -> f64 {
-        if self.energy_scale > 0.0 {
+        if self.e_ref < self.energy_scale {
             (self.energy_scale / self.e_ref).sqrt()
         } else {
             1.0
@@ -210,7 +213,7 @@ where
     } else {
         (*tau, SMatrix::zeros())
     };
-    // k = 1 exactly at the paper's set-up (E_ref = E_s, or E_s = 0), so
+    // k = 1 exactly at the paper's set-up (E_ref >= E_s, or E_s = 0), so
     // the paper's runs are unchanged to the last bit.
     let k = params.energy_residual_factor();
     let mut r = Residuals {

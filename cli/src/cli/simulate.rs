@@ -60,9 +60,9 @@ pub struct SimulateArgs {
     /// Energy weight w_E (default: 25 curved, 5 straight).
     #[arg(long, allow_negative_numbers = true)]
     w_e: Option<f64>,
-    /// Energy scale E_s (J) of the energy residual r_E = (E_ref - E) sqrt(E_s / E_ref): every
-    /// E_ref is pulled towards as E_s is (w_E was tuned at 14 J, the default); 0: the paper's
-    /// r_E = E_ref - E.
+    /// Energy scale E_s (J): below it the energy residual is r_E = (E_ref - E) sqrt(E_s / E_ref),
+    /// so that a low E_ref is pulled towards as E_s is (w_E was tuned at 14 J, the default); from
+    /// E_s up, and with 0, the paper's r_E = E_ref - E.
     #[arg(long, default_value_t = eigenmpc::mpc::PAPER_ENERGY_SCALE, allow_negative_numbers = true)]
     e_scale: f64,
     /// Position weight w_x.

@@ -47,9 +47,9 @@ pub struct Tuning {
     pub w_xd: f64,
     /// Torque weight `w_F`.
     pub w_f: f64,
-    /// Energy scale `E_s` (J) of the energy residual
+    /// Energy scale `E_s` (J): below it the energy residual is
     /// `r_E = (E_ref - E) sqrt(E_s / E_ref)` ([`CostParams::energy_scale`];
-    /// 0: the paper's `E_ref - E`).
+    /// from `E_s` up, and with 0, the paper's `E_ref - E`).
     pub e_scale: f64,
 }
 

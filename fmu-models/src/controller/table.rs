@@ -243,10 +243,11 @@ pub fn table<const N: usize>() -> Table<Settings<N>> {
             |s, _| s.tuning.e_scale,
             |s, _, v| s.tuning.e_scale = v,
             (0.0, 1e4),
-            "energy scale E_s of the energy residual r_E = (E_ref - E) sqrt(E_s/E_ref): every \
-             E_ref is pulled towards as E_ref = E_s is, where r_E is the paper's (default 14 J, \
-             the energy w_E was tuned at); **0 = the paper's E_ref - E** (a low E_ref is then \
-             approached slowly); with E_s > 0, E_ref must be > 0",
+            "energy scale E_s: for E_ref < E_s the energy residual is r_E = (E_ref - E) \
+             sqrt(E_s/E_ref), so that a low E_ref is pulled towards as E_s is (default 14 J, \
+             the energy w_E was tuned at); from E_s up the paper's E_ref - E; **0 = the \
+             paper's residual at every E_ref** (a low E_ref is then approached slowly); with \
+             E_s > 0, E_ref must be > 0",
         )
         .unit("J"),
     );
