@@ -66,7 +66,11 @@ fn scaled_residual_is_exactly_the_papers_from_e_s_up() {
             let a = residuals::<_, 2, 4>(&sys, &reference, &absolute, z, &tau);
             let r = residuals::<_, 2, 4>(&sys, &reference, &scaled, z, &tau);
             let (q, qd) = (z.fixed_rows::<2>(0).into(), z.fixed_rows::<2>(2).into());
-            assert_eq!(a.energy, e_ref - sys.energy(&q, &qd), "{v}: the paper's r_E");
+            assert_eq!(
+                a.energy,
+                e_ref - sys.energy(&q, &qd),
+                "{v}: the paper's r_E"
+            );
             assert_eq!(r.energy, a.energy, "{v} {z:?}");
             assert_eq!(r.energy_z, a.energy_z, "{v} {z:?}");
             assert_eq!(r.position, a.position);
