@@ -43,6 +43,23 @@ fn variants() -> [(Reference<2>, Variant, CostParams); 3] {
     ]
 }
 
+/// [`variants`] at the paper's 14 J, with the energy residual relative to
+/// a 3 J `E_ref` (factor 14/3) and absolute at 3 J: every form of `r_E`.
+fn scaled_variants() -> Vec<(Reference<2>, Variant, CostParams)> {
+    let mut out = vec![];
+    for (reference, variant, p) in variants() {
+        for (e_ref, energy_scale) in [(14.0, 14.0), (3.0, 14.0), (3.0, 0.0)] {
+            let p = CostParams {
+                e_ref,
+                energy_scale,
+                ..p
+            };
+            out.push((reference.clone(), variant, p));
+        }
+    }
+    out
+}
+
 fn params(variant: Variant) -> CostParams {
     MpcConfig::paper(variant).cost
 }
@@ -69,7 +86,7 @@ fn residual_jacobians_match_finite_differences() {
         Z::new(0.05, 0.05, 0.0, 0.0),
     ];
     let tau = Vector::<2>::new(0.4, -0.7);
-    for (reference, variant, p) in variants() {
+    for (reference, variant, p) in scaled_variants() {
         for z in &states {
             let r = residuals::<_, 2, 4>(&sys, &reference, &p, z, &tau);
             let h = 1e-6;
@@ -142,7 +159,7 @@ fn gauss_newton_model_is_psd_and_consistent_with_cost() {
     let sys = DoublePendulum::default();
     let z = Z::new(0.4, 0.3, -1.0, 0.5);
     let tau = Vector::<2>::new(0.2, 0.1);
-    for (reference, variant, p) in variants() {
+    for (reference, variant, p) in scaled_variants() {
         let m = stage_model::<_, 2, 4>(&sys, &reference, &p, &z, &tau, 0.025);
         let mut h = nalgebra::SMatrix::<f64, 6, 6>::zeros();
         h.fixed_view_mut::<4, 4>(0, 0).copy_from(&m.q);
@@ -438,7 +455,7 @@ fn e_ref_change_between_samples_changes_the_plan() {
     b.step(&z);
     a.prepare();
     b.prepare();
-    b.set_e_ref(0.0).unwrap(); // after preparation: the controller re-linearises
+    b.set_e_ref(3.0).unwrap(); // after preparation: the controller re-linearises
     let ta = a.step(&z).tau;
     let tb = b.step(&z).tau;
     assert!((ta - tb).amax() > 1e-3, "{ta:?} vs {tb:?}");

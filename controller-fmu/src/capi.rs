@@ -96,6 +96,11 @@ pub struct EigenMpcConfig {
     /// model (real-time loops); 0 (default) = the next look waits for it
     /// (reproducible offline runs). As the FMU's `adapt_realtime`.
     pub adapt_realtime: i32,
+    /// Energy scale E_s (J), >= 0: for E_ref < E_s the energy residual is
+    /// r_E = (E_ref - E) sqrt(E_s / E_ref) (default 14, where w_E was tuned;
+    /// from E_s up, and with 0, the paper's E_ref - E). As the FMU's
+    /// `E_scale`; last, so that the offsets of the fields before it stay.
+    pub e_scale: f64,
 }
 
 /// Diagnostics of the last [`eigenmpc_step`].
@@ -198,7 +203,7 @@ impl EigenMpc {
 /// The config's fields as the controller FMU's parameters: `(C field,
 /// FMU name, value)`. The FMU's variable table checks them, so the C API
 /// and the FMU accept the same ranges.
-fn named_fields(config: &EigenMpcConfig) -> [(&'static str, &'static str, f64); 25] {
+fn named_fields(config: &EigenMpcConfig) -> [(&'static str, &'static str, f64); 26] {
     [
         ("variant", "variant", f64::from(config.variant)),
         ("e_ref", "E_ref", config.e_ref),
@@ -237,6 +242,7 @@ fn named_fields(config: &EigenMpcConfig) -> [(&'static str, &'static str, f64); 
             "adapt_realtime",
             f64::from(config.adapt_realtime),
         ),
+        ("e_scale", "E_scale", config.e_scale),
     ]
 }
 
@@ -275,6 +281,7 @@ fn tuning_from(config: &EigenMpcConfig) -> Tuning {
         w_x: config.w_x,
         w_xd: config.w_xd,
         w_f: config.w_f,
+        e_scale: config.e_scale,
     }
 }
 
@@ -325,6 +332,7 @@ pub extern "C" fn eigenmpc_config_default(variant: i32) -> EigenMpcConfig {
         adapt: i32::from(s.adapt),
         adapt_period: s.adapt_period,
         adapt_realtime: i32::from(s.adapt_realtime),
+        e_scale: s.tuning.e_scale,
     }
 }
 
@@ -516,7 +524,7 @@ pub unsafe extern "C" fn eigenmpc_set_e_ref(mpc: *mut EigenMpc, e_ref: f64) -> i
 }
 
 /// Takes over the tunable fields of `config` (e_ref, alpha, beta, w_e, w_x,
-/// w_xd, w_f) for the following steps; the other fields are ignored. Returns
+/// w_xd, w_f, e_scale) for the following steps; the other fields are ignored. Returns
 /// 0, or `EIGENMPC_STATUS_BAD_ARGUMENT` (nothing changed).
 ///
 /// # Safety
@@ -533,8 +541,8 @@ pub unsafe extern "C" fn eigenmpc_set_tuning(
                 return h.fail("eigenmpc_set_tuning: config is NULL".into());
             }
             let fields = named_fields(&*config);
-            // The tunables: e_ref .. w_f, checked by the FMU's table.
-            for &(field, name, v) in &fields[1..8] {
+            // The tunables: e_ref .. w_f and e_scale, checked by the FMU's table.
+            for &(field, name, v) in fields[1..8].iter().chain(&fields[25..]) {
                 if let Err(e) = check_tunable(h.controller.joints(), name, v) {
                     return h.fail(format!("eigenmpc_set_tuning: config.{field}: {e}"));
                 }

@@ -1115,6 +1115,26 @@ fn c_api_ranges_are_the_fmus() {
         msg.contains("config.w_x: w_x = -1 is below its minimum"),
         "{msg}"
     );
+    // The energy scale (the last field) is a tunable too: checked as the
+    // FMU's E_scale, and E_ref = 0 only with the paper's residual (0).
+    assert_eq!(cfg.e_scale, 14.0);
+    let mut tuned = cfg;
+    tuned.e_scale = -1.0;
+    assert_eq!(
+        unsafe { eigenmpc_set_tuning(mpc, &tuned) },
+        STATUS_BAD_ARGUMENT
+    );
+    let msg = unsafe { CStr::from_ptr(eigenmpc_last_error(mpc)) }
+        .to_str()
+        .unwrap();
+    assert!(
+        msg.contains("config.e_scale: E_scale = -1 is below its minimum"),
+        "{msg}"
+    );
+    assert_eq!(unsafe { eigenmpc_set_e_ref(mpc, 0.0) }, STATUS_BAD_ARGUMENT);
+    tuned.e_scale = 0.0;
+    tuned.e_ref = 0.0;
+    assert_eq!(unsafe { eigenmpc_set_tuning(mpc, &tuned) }, 0);
     assert_eq!(unsafe { eigenmpc_set_e_ref(mpc, 8.0) }, 0);
     unsafe { eigenmpc_free(mpc) };
 }

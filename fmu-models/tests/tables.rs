@@ -104,7 +104,9 @@ fn the_two_joint_controller_keeps_the_original_value_references() {
     assert_eq!(vr(&d, "estimate.A[2,2]"), (BaseType::Real, 147));
     assert_eq!(vr(&d, "estimate.cf[2]"), (BaseType::Real, 155));
     assert_eq!(vr(&d, "model_updates"), (BaseType::Integer, 8));
-    assert_eq!(d.variables.len(), 24 + 20 + 5 + 17 + 6 + 4 + 3 + 11 + 1);
+    // then the energy scale (issue 19)
+    assert_eq!(vr(&d, "E_scale"), (BaseType::Real, 156));
+    assert_eq!(d.variables.len(), 24 + 20 + 5 + 17 + 6 + 4 + 3 + 11 + 1 + 1);
 }
 
 /// Every variable of the original `DoublePendulum.fmu` keeps its name and

@@ -2,7 +2,7 @@
 //! its errors.
 
 use super::Variant;
-use super::cost::{CostParams, Weights};
+use super::cost::{CostParams, PAPER_ENERGY_SCALE, Weights};
 use super::estimator::EstimatorConfig;
 use crate::qp::QpBackend;
 use thiserror::Error;
@@ -68,7 +68,9 @@ pub struct MpcConfig {
 impl MpcConfig {
     /// The paper's setting (section V-A): N = 80, dt = 25 ms, |tau| <= 1 N m,
     /// w_x = 50, w_xd = 2500, w_F = 225, w_E = 25 (curved) / 5 (straight),
-    /// alpha = beta = 0.1, E_ref = 14 J.
+    /// alpha = beta = 0.1, E_ref = 14 J; below 14 J the energy residual
+    /// scaled by sqrt(14 J / E_ref) ([`CostParams::energy_scale`]), from
+    /// 14 J up the paper's residual exactly.
     pub fn paper(variant: Variant) -> Self {
         Self {
             horizon: 80,
@@ -80,6 +82,7 @@ impl MpcConfig {
                 alpha: 0.1,
                 beta: 0.1,
                 weights: Weights::paper(variant),
+                energy_scale: PAPER_ENERGY_SCALE,
                 compensate_friction: true,
             },
             terminal_scale: 0.0,
@@ -167,6 +170,7 @@ pub(crate) fn validate_cost(c: &CostParams) -> Result<(), MpcError> {
         ("w_x", c.weights.position),
         ("w_xd", c.weights.velocity),
         ("w_F", c.weights.torque),
+        ("energy_scale", c.energy_scale),
     ];
     for (name, value) in checks {
         if !(value.is_finite() && value >= 0.0) {
@@ -176,6 +180,14 @@ pub(crate) fn validate_cost(c: &CostParams) -> Result<(), MpcError> {
                 reason: "must be finite and >= 0",
             });
         }
+    }
+    if c.energy_scale > 0.0 && c.e_ref == 0.0 {
+        // The scaled residual divides by E_ref.
+        return Err(MpcError::InvalidParameter {
+            name: "e_ref",
+            value: 0.0,
+            reason: "must be > 0 with a scaled energy residual (energy_scale > 0; 0: the paper's)",
+        });
     }
     if c.weights.torque == 0.0 {
         // Without a torque weight the QP Hessian is singular in tau.

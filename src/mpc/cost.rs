@@ -1,6 +1,12 @@
 //! The EigenMPC running costs (paper, eqs. 10 and 12) in least-squares form
 //! `l = w_E r_E^2 + w_x |r_x|^2 + w_xd |r_xd|^2 + w_F |r_F|^2`, their exact
 //! residual Jacobians and the Gauss-Newton Hessian blocks they give.
+//!
+//! Below the energy scale `E_s` the energy residual is scaled by
+//! `sqrt(E_s / E_ref)` ([`CostParams::energy_scale`]): the paper's
+//! `r_E = E_ref - E` values a joule gained at a given fraction of the climb
+//! in proportion to `E_ref`, so its weights, tuned at 14 J, pull towards
+//! 3 J with a fifth of that.
 
 use super::Variant;
 use crate::mechanics::{Matrix, MechanicalSystem, Vector, unpack_state};
@@ -106,6 +112,11 @@ impl<const N: usize> Reference<N> {
     }
 }
 
+/// The energy at which the paper tuned `w_E` (its `E_ref`, section V-A):
+/// the default [`CostParams::energy_scale`], at which the scaled energy
+/// residual is exactly the paper's.
+pub const PAPER_ENERGY_SCALE: f64 = 14.0;
+
 /// Tunable cost parameters (may change between samples).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CostParams {
@@ -117,17 +128,44 @@ pub struct CostParams {
     pub beta: f64,
     /// Residual weights.
     pub weights: Weights,
+    /// Energy scale `E_s` (J): below it the energy residual is
+    /// `r_E = (E_ref - E) sqrt(E_s / E_ref)`, from it up the paper's
+    /// `E_ref - E`. What the energy term trades against the torque is the
+    /// value of a joule gained, `d(w_E r_E^2)/dE`: with the paper's residual
+    /// `-2 w_E E_ref (1 - E/E_ref)`, which at a low `E_ref` is a fraction of
+    /// what `w_E` was tuned for, so a low `E_ref` is approached slowly.
+    /// Scaled, it is `-2 w_E E_s (1 - E/E_ref)`: the same function of the
+    /// climb's progress as at `E_ref = E_s`. The scale only lifts: it never
+    /// pulls less than the paper's residual, and at and above `E_s` (default
+    /// [`PAPER_ENERGY_SCALE`], where `w_E` was tuned) the residual is the
+    /// paper's exactly. 0: the paper's residual at every `E_ref` (and what
+    /// a saved state without this field computed). With `E_s > 0`, `E_ref`
+    /// must be > 0.
+    #[serde(default)]
+    pub energy_scale: f64,
     /// Penalise the torque beyond the model's friction, `tau - tau_f(qd)`,
     /// instead of `tau` (no effect on a frictionless model).
     pub compensate_friction: bool,
 }
 
+impl CostParams {
+    /// The factor `k` of the energy residual: `sqrt(E_s / E_ref)` below
+    /// `E_s`, exactly 1 from `E_s` up (so also with `energy_scale = 0`).
+    pub fn energy_residual_factor(&self) -> f64 {
+        if self.e_ref < self.energy_scale {
+            (self.energy_scale / self.e_ref).sqrt()
+        } else {
+            1.0
+        }
+    }
+}
+
 /// Residuals of one stage and their Jacobians w.r.t. `z = (q, qd)` and `tau`.
 #[derive(Clone, Copy, Debug)]
 pub struct Residuals<const N: usize, const NX: usize> {
-    /// `E_ref - E`.
+    /// `(E_ref - E) k`, `k` = [`CostParams::energy_residual_factor`].
     pub energy: f64,
-    /// `d(E_ref - E)/dz`.
+    /// `d r_E / dz = -k dE/dz`.
     pub energy_z: SVector<f64, NX>,
     /// Position distance `r_x`.
     pub position: Vector<N>,
@@ -175,9 +213,12 @@ where
     } else {
         (*tau, SMatrix::zeros())
     };
+    // k = 1 exactly at the paper's set-up (E_ref >= E_s, or E_s = 0), so
+    // the paper's runs are unchanged to the last bit.
+    let k = params.energy_residual_factor();
     let mut r = Residuals {
-        energy: params.e_ref - energy,
-        energy_z: -grad_e,
+        energy: (params.e_ref - energy) * k,
+        energy_z: -grad_e * k,
         position: Vector::<N>::zeros(),
         position_z: SMatrix::zeros(),
         velocity: Vector::<N>::zeros(),

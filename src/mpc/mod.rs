@@ -27,7 +27,7 @@ mod status;
 mod variant;
 
 pub use config::{MAX_HORIZON, MpcConfig, MpcError, SqpOptions};
-pub use cost::{CostParams, Reference, Weights};
+pub use cost::{CostParams, PAPER_ENERGY_SCALE, Reference, Weights};
 pub use estimator::EstimatorConfig;
 pub use prediction::{prediction_coulomb_sharpness, prediction_substeps};
 pub use saved::ControllerState;

@@ -45,8 +45,10 @@ def test_model_description(controller_md):
     # the energy depends on the state and the model's inertia and potential, not on friction or tuning
     model = [f"{p}[{j}]" for p in ["m", "l", "r", "I", "Ir", "gr", "k", "q_rest"] for j in (1, 2)] + ["g"]
     assert sorted(d.name for d in initial["energy"]) == sorted(STATE + model)
-    for name in ["E_ref", "alpha", "beta", "w_E", "w_x", "w_xd", "w_F"]:
+    for name in ["E_ref", "alpha", "beta", "w_E", "w_x", "w_xd", "w_F", "E_scale"]:
         assert v[name].variability == "tunable", name
+    # below E_scale the energy residual is scaled (issue 19); 14 J: the paper's from 14 J up
+    assert float(v["E_scale"].start) == 14.0 and v["E_scale"].unit == "J"
     for name in ["tau_max", "horizon", "sample_period", "m[1]", "g", "c[2]", "chart.coef[2,9]"]:
         assert v[name].variability == "fixed", name
     assert v["variant"].type == "Enumeration" and v["variant"].start == "2"

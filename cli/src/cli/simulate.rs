@@ -60,6 +60,11 @@ pub struct SimulateArgs {
     /// Energy weight w_E (default: 25 curved, 5 straight).
     #[arg(long, allow_negative_numbers = true)]
     w_e: Option<f64>,
+    /// Energy scale E_s (J): below it the energy residual is r_E = (E_ref - E) sqrt(E_s / E_ref),
+    /// so that a low E_ref is pulled towards as E_s is (w_E was tuned at 14 J, the default); from
+    /// E_s up, and with 0, the paper's r_E = E_ref - E.
+    #[arg(long, default_value_t = eigenmpc::mpc::PAPER_ENERGY_SCALE, allow_negative_numbers = true)]
+    e_scale: f64,
     /// Position weight w_x.
     #[arg(long, default_value_t = 50.0, allow_negative_numbers = true)]
     w_x: f64,
@@ -271,6 +276,7 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
     if let Some(w) = args.w_e {
         config.cost.weights.energy = w;
     }
+    config.cost.energy_scale = args.e_scale;
     config.cost.weights.position = args.w_x;
     config.cost.weights.velocity = args.w_xd;
     config.cost.weights.torque = args.w_f;

@@ -29,7 +29,11 @@ at <code>fmi2ExitInitializationMode</code> with a message naming the parameter.<
 of the eigenmode at <code>E_ref</code> (default: the in-phase mode of the default model); \
 compute other charts with <code>eigenmpc modes --energies E --fmu-start-values FILE</code> \
 and load FILE as start values. A negative <code>w_E</code> (the default) selects the paper's \
-energy weight of the variant: 25 curved, 5 straight.</p>\
+energy weight of the variant: 25 curved, 5 straight. Below <code>E_scale</code> (default \
+14 J, where the paper tuned <code>w_E</code>) the energy residual is scaled by \
+<code>sqrt(E_scale / E_ref)</code>, so that a low <code>E_ref</code> is reached about as fast \
+as 14 J; from <code>E_scale</code> up, and with <code>E_scale</code> = 0, it is the \
+paper's <code>E_ref - E</code>.</p>\
 <p><b>solver_status.</b> 0 solved; 1 first-sample SQP not converged (torque from the last \
 iterate); 2 QP failed: the torque is the fallback (the previous plan's next control, clipped) \
 and a warning is logged. Code 3 (invalid state) belongs to the C API: this FMU refuses NaN/Inf \

@@ -47,6 +47,10 @@ pub struct Tuning {
     pub w_xd: f64,
     /// Torque weight `w_F`.
     pub w_f: f64,
+    /// Energy scale `E_s` (J): below it the energy residual is
+    /// `r_E = (E_ref - E) sqrt(E_s / E_ref)` ([`CostParams::energy_scale`];
+    /// from `E_s` up, and with 0, the paper's `E_ref - E`).
+    pub e_scale: f64,
 }
 
 impl Tuning {
@@ -61,6 +65,7 @@ impl Tuning {
             w_x: p.weights.position,
             w_xd: p.weights.velocity,
             w_f: p.weights.torque,
+            e_scale: p.energy_scale,
         }
     }
 
@@ -77,6 +82,7 @@ impl Tuning {
                 velocity: self.w_xd,
                 torque: self.w_f,
             },
+            energy_scale: self.e_scale,
             ..MpcConfig::paper(variant).cost
         }
     }

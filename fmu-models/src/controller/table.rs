@@ -237,6 +237,20 @@ pub fn table<const N: usize>() -> Table<Settings<N>> {
     rows.extend(computed_reference_rows::<N>());
     rows.extend(estimator_rows::<N>());
     rows.extend(adaptation_rows::<N>());
+    rows.push(
+        tunable(
+            "E_scale",
+            |s, _| s.tuning.e_scale,
+            |s, _, v| s.tuning.e_scale = v,
+            (0.0, 1e4),
+            "energy scale E_s: for E_ref < E_s the energy residual is r_E = (E_ref - E) \
+             sqrt(E_s/E_ref), so that a low E_ref is pulled towards as E_s is (default 14 J, \
+             the energy w_E was tuned at); from E_s up the paper's E_ref - E; **0 = the \
+             paper's residual at every E_ref** (a low E_ref is then approached slowly); with \
+             E_s > 0, E_ref must be > 0",
+        )
+        .unit("J"),
+    );
     Table::new(N, rows)
 }
 
