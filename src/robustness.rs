@@ -111,7 +111,6 @@ pub fn run_imperfect<const N: usize, const NX: usize, const NP: usize>(
         std::iter::repeat_n(*z0, imperfections.delay_samples).collect();
     let a = imperfections.responsiveness;
     let mut applied = Vector::<N>::zeros();
-    let mut commanded = Vector::<N>::zeros();
     for i in 0..=steps {
         let t = i as f64 * dt;
         let z = *ode.state();
@@ -132,11 +131,14 @@ pub fn run_imperfect<const N: usize, const NX: usize, const NP: usize>(
             let used = controller.state_estimate().copied().unwrap_or(measured);
             let q = Vector::<N>::from_fn(|j, _| used[j]);
             let qd = Vector::<N>::from_fn(|j, _| used[N + j]);
-            adaptation.sample(controller, &q, &qd, &commanded, dt);
+            // The torque that acted before the measurement was taken, as
+            // far as the controller knows (the previous command when it
+            // declares neither delay nor lag).
+            let tau = controller.torque_before_measurement();
+            adaptation.sample(controller, &q, &qd, &tau, dt);
         }
         adaptation_time.push(started.elapsed().as_secs_f64());
-        commanded = out.tau;
-        applied = commanded * a + applied * (1.0 - a);
+        applied = out.tau * a + applied * (1.0 - a);
         let mut torque = applied;
         if imperfections.torque_noise > 0.0 {
             for j in 0..N {

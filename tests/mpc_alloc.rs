@@ -174,4 +174,25 @@ fn control_steps_do_not_allocate() {
         total, 0,
         "controller with estimator allocated {total} times"
     );
+
+    // With a measurement delay (fractional: 2.5 samples), an actuator lag
+    // and the estimator: the forward prediction and the command history
+    // allocate nothing either.
+    config.measurement_delay = 0.0625;
+    config.actuator_time_constant = 0.05;
+    let mut ctrl = Controller::<_, 2, 4>::new(sys, config, ctrl.reference().clone()).unwrap();
+    let mut z = SVector::<f64, 4>::new(0.3, 0.2, 0.0, 0.0);
+    z = eigenmpc::integrate::rk4_step::<_, 2, 4>(&sys, &z, &ctrl.step(&z).tau, 0.025);
+    let before = OURS.load(Ordering::SeqCst) + BACKEND.load(Ordering::SeqCst);
+    for _ in 0..50 {
+        let out = ctrl.step(&z);
+        assert!(out.status.is_ok());
+        assert!(ctrl.predicted_current_state().is_some());
+        z = eigenmpc::integrate::rk4_step::<_, 2, 4>(&sys, &z, &out.tau, 0.025);
+    }
+    let total = OURS.load(Ordering::SeqCst) + BACKEND.load(Ordering::SeqCst) - before;
+    assert_eq!(
+        total, 0,
+        "controller with delay, lag and estimator allocated {total} times"
+    );
 }

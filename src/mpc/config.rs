@@ -63,7 +63,21 @@ pub struct MpcConfig {
     /// State estimator on the measured state (None, the default: the
     /// measurement is used as it is).
     pub estimator: Option<EstimatorConfig>,
+    /// Age of the measured state when it reaches the controller (s; 0, the
+    /// default: current). The controller predicts it forward over the
+    /// delay with the torques it sent meanwhile (see [`super::delay`]);
+    /// at most [`MAX_COMPENSATED_TIME`] and the horizon's length.
+    pub measurement_delay: f64,
+    /// Time constant `T` of the actuator's first-order lag
+    /// `da/dt = (tau - a) / T` between the commanded torque `tau` and the
+    /// applied one `a` (s; 0, the default: immediate); same bounds as
+    /// [`MpcConfig::measurement_delay`].
+    pub actuator_time_constant: f64,
 }
+
+/// Longest measurement delay or actuator time constant the controller
+/// compensates (s): its history of commands is sized for it at creation.
+pub const MAX_COMPENSATED_TIME: f64 = 1.0;
 
 impl MpcConfig {
     /// The paper's setting (section V-A): N = 80, dt = 25 ms, |tau| <= 1 N m,
@@ -95,6 +109,8 @@ impl MpcConfig {
             sqp: SqpOptions::default(),
             qp: QpBackend::default(),
             estimator: None,
+            measurement_delay: 0.0,
+            actuator_time_constant: 0.0,
         }
     }
 
@@ -146,6 +162,21 @@ impl MpcConfig {
         }
         if let Some(e) = &self.estimator {
             e.validate()?;
+        }
+        for (name, v) in [
+            ("measurement_delay", self.measurement_delay),
+            ("actuator_time_constant", self.actuator_time_constant),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return bad(name, v, "must be finite and >= 0");
+            }
+            if v > MAX_COMPENSATED_TIME {
+                return bad(name, v, "must be at most 1 s");
+            }
+            // Checked after dt: the horizon's length is finite here.
+            if v > self.horizon as f64 * self.dt {
+                return bad(name, v, "must be at most the horizon's length (horizon dt)");
+            }
         }
         if self.sqp.max_iterations == 0 {
             return bad("sqp.max_iterations", 0.0, "must be >= 1");

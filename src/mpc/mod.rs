@@ -18,6 +18,7 @@
 pub mod closed_loop;
 mod config;
 pub mod cost;
+mod delay;
 mod estimator;
 mod linearise;
 pub mod prediction;
@@ -26,7 +27,7 @@ mod sqp;
 mod status;
 mod variant;
 
-pub use config::{MAX_HORIZON, MpcConfig, MpcError, SqpOptions};
+pub use config::{MAX_COMPENSATED_TIME, MAX_HORIZON, MpcConfig, MpcError, SqpOptions};
 pub use cost::{CostParams, PAPER_ENERGY_SCALE, Reference, Weights};
 pub use estimator::EstimatorConfig;
 pub use prediction::{prediction_coulomb_sharpness, prediction_substeps};
@@ -73,8 +74,13 @@ pub struct Controller<S, const N: usize, const NX: usize> {
     family: Option<ChartFamily<N>>,
     /// State estimator (None: the measured state is used as it is).
     estimator: Option<estimator::Ekf<N, NX>>,
-    /// Torque returned by the last feedback (applied over the last sample).
-    applied_tau: Vector<N>,
+    /// Torques returned by the past feedbacks (the last one is applied
+    /// over the last sample), for the measurement delay, the actuator lag
+    /// and the estimator's propagation ([`delay`]).
+    history: delay::CommandHistory<N>,
+    /// The state the last feedback embedded as the plan's start (the
+    /// measurement, filtered and predicted over delay and lag).
+    embedded: Option<SVector<f64, NX>>,
 }
 
 /// QP failures in a row after which the plan is discarded and the next
@@ -132,7 +138,12 @@ where
             consecutive_qp_failures: 0,
             family: None,
             estimator: config.estimator.map(|e| estimator::Ekf::new(&e, config.dt)),
-            applied_tau: Vector::zeros(),
+            history: delay::CommandHistory::new(delay::history_length(
+                config.measurement_delay,
+                config.actuator_time_constant,
+                config.dt,
+            )),
+            embedded: None,
         })
     }
 
@@ -328,21 +339,36 @@ where
         }
     }
 
-    /// The state estimate the last sample used (None without an estimator
-    /// or before the first sample).
+    /// The state estimate of the last sample (None without an estimator
+    /// or before the first sample): the filtered state **at the time the
+    /// measurement was taken**, `measurement_delay` before the sample.
+    /// That is what an identification pairs with the torque acting then
+    /// (the command `measurement_delay` earlier); the state the plan
+    /// started from is [`Controller::predicted_current_state`].
     pub fn state_estimate(&self) -> Option<&SVector<f64, NX>> {
         self.estimator.as_ref().and_then(|e| e.estimate())
     }
 
-    /// Propagates the state estimate over the last sample with the torque
-    /// applied (once per sample; part of the preparation).
+    /// The state the last feedback started its plan from (None before the
+    /// first sample): the measurement (filtered, with the estimator)
+    /// predicted forward over `measurement_delay` to the sample time and,
+    /// with an actuator lag, over `actuator_time_constant` more (see
+    /// [`MpcConfig::actuator_time_constant`]). Without either it is the
+    /// (filtered) measurement.
+    pub fn predicted_current_state(&self) -> Option<&SVector<f64, NX>> {
+        self.embedded.as_ref()
+    }
+
+    /// Propagates the state estimate over the sample before the coming
+    /// measurement with the torque that acted then (once per sample; part
+    /// of the preparation).
     fn predict_estimate(&mut self) {
         let Some(ekf) = &self.estimator else { return };
         if !ekf.needs_prediction() {
             return;
         }
         let from = *ekf.estimate().expect("started");
-        let (next, a, _) = self.interval_sensitivity(&from, &self.applied_tau);
+        let (next, a) = self.propagate_delayed(&from);
         if let Some(ekf) = &mut self.estimator {
             ekf.predict(&next, &a);
         }
@@ -394,6 +420,24 @@ where
             }
             None => z,
         };
+        // The plan starts where the command takes effect: the measured
+        // (filtered) state predicted over delay and lag; a diverged
+        // prediction falls back to the measurement.
+        let predicted;
+        let z = if measured && self.compensates() {
+            let p = self.predict_measured(z);
+            predicted = if p.iter().all(|v| v.is_finite()) {
+                p
+            } else {
+                *z
+            };
+            &predicted
+        } else {
+            z
+        };
+        if measured {
+            self.embedded = Some(*z);
+        }
         let preparation_time = std::mem::take(&mut self.pending_preparation_time);
         let mut out = if !measured {
             self.fallback(ControlStatus::InvalidState)
@@ -427,7 +471,8 @@ where
             }
             ControlStatus::InvalidState => {}
         }
-        self.applied_tau = out.tau;
+        let decay = self.lag_decay();
+        self.history.push(&out.tau, decay);
         out.preparation_time = preparation_time;
         out.feedback_time = start.elapsed().as_secs_f64();
         out

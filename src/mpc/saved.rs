@@ -3,6 +3,7 @@
 //! bit (the FMU's `fmi2GetFMUstate`). The solver's workspace and the QP are
 //! not saved: the next preparation rebuilds them from the plan.
 
+use super::delay::CommandHistory;
 use super::estimator::Ekf;
 use super::{Controller, CostParams, MpcError, Reference};
 use crate::mechanics::{MechanicalSystem, Vector};
@@ -29,7 +30,9 @@ pub struct ControllerState<S, const N: usize, const NX: usize> {
     warm_start_usable: bool,
     consecutive_qp_failures: usize,
     estimator: Option<Ekf<N, NX>>,
-    applied_tau: Vector<N>,
+    /// The past commands (delay, lag and estimator need them).
+    history: CommandHistory<N>,
+    embedded: Option<SVector<f64, NX>>,
     /// The QP solver's warm start ([`crate::qp::QpSolver::save_warm_start`]).
     solver: Vec<f64>,
 }
@@ -55,7 +58,8 @@ where
             warm_start_usable: self.warm_start_usable,
             consecutive_qp_failures: self.consecutive_qp_failures,
             estimator: self.estimator.clone(),
-            applied_tau: self.applied_tau,
+            history: self.history.clone(),
+            embedded: self.embedded,
             solver: self.solver.save_warm_start(),
         }
     }
@@ -85,8 +89,18 @@ where
         {
             return bad("a state with another mode family or estimator set-up".into());
         }
+        if state.history.len() != self.history.len() {
+            return bad(format!(
+                "a history of {} commands for {} (another delay or lag)",
+                state.history.len(),
+                self.history.len()
+            ));
+        }
         let finite = state.merit_penalty.is_finite()
-            && state.applied_tau.iter().all(|v| v.is_finite())
+            && state.history.is_finite()
+            && state
+                .embedded
+                .is_none_or(|x| x.iter().all(|v| v.is_finite()))
             && state.xs.iter().all(|x| x.iter().all(|v| v.is_finite()))
             && state.us.iter().all(|u| u.iter().all(|v| v.is_finite()));
         if !finite {
@@ -111,7 +125,8 @@ where
         self.warm_start_usable = state.warm_start_usable;
         self.consecutive_qp_failures = state.consecutive_qp_failures;
         self.estimator = state.estimator;
-        self.applied_tau = state.applied_tau;
+        self.history = state.history;
+        self.embedded = state.embedded;
         // The QP is rebuilt from the plan (deterministic: the same numbers).
         self.prepared = false;
         self.pending_preparation_time = 0.0;
