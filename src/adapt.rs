@@ -1,7 +1,8 @@
 //! Online adaptation of a controller's model, safe to leave on: the
 //! energy-balance identification ([`crate::identify`]) is fed every sample
 //! with the torque the robot felt over the measured interval (after the
-//! measurement delay and the actuator's lag); a model is made of its
+//! controller's declared measurement delay and actuator lag,
+//! [`Controller::torque_before_measurement`]); a model is made of its
 //! estimate only when it
 //!
 //! 1. is physical and inside a trust region around the model in use (a
@@ -32,9 +33,6 @@ use nalgebra::SVector;
 use std::sync::{Arc, Condvar, Mutex};
 use std::thread::JoinHandle;
 
-/// Longest measurement delay the torque alignment covers (samples).
-pub const MAX_DELAY_SAMPLES: usize = 64;
-
 /// When and how the model follows the estimate.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AdaptOptions {
@@ -60,11 +58,6 @@ pub struct AdaptOptions {
     pub family_energy_max: f64,
     /// Identification settings.
     pub rls: RlsOptions,
-    /// Measurement delay (s): the state measured now is the robot's this
-    /// long ago, so the torque that moved it was sent this long before.
-    pub measurement_delay: f64,
-    /// Time constant of the actuator's first-order lag (s, 0: none).
-    pub actuator_time_constant: f64,
     /// Offline simulation: wait for the worker's model at the next look
     /// (deterministic closed loops whatever the machine's speed). Never for
     /// a real-time loop.
@@ -83,8 +76,6 @@ impl Default for AdaptOptions {
             judge_samples: 80,
             family_energy_max: -1.0,
             rls: RlsOptions::default(),
-            measurement_delay: 0.0,
-            actuator_time_constant: 0.0,
             synchronous: false,
         }
     }
@@ -92,7 +83,7 @@ impl Default for AdaptOptions {
 
 impl AdaptOptions {
     /// Checks the options; the message names the offending one.
-    pub fn validate(&self, dt: f64) -> Result<(), IdentifyError> {
+    pub fn validate(&self) -> Result<(), IdentifyError> {
         let bad = |what: String| Err(IdentifyError::NotPhysical(what));
         for (name, v) in [
             ("min_change", self.min_change),
@@ -112,22 +103,6 @@ impl AdaptOptions {
         }
         if self.judge_samples == 0 {
             return bad("judge_samples must be >= 1".into());
-        }
-        if !(self.measurement_delay.is_finite()
-            && self.measurement_delay >= 0.0
-            && self.measurement_delay <= dt * (MAX_DELAY_SAMPLES - 2) as f64)
-        {
-            return bad(format!(
-                "measurement_delay = {} s must be in [0, {} samples]",
-                self.measurement_delay,
-                MAX_DELAY_SAMPLES - 2
-            ));
-        }
-        if !(self.actuator_time_constant.is_finite() && self.actuator_time_constant >= 0.0) {
-            return bad(format!(
-                "actuator_time_constant = {} must be finite and >= 0",
-                self.actuator_time_constant
-            ));
         }
         self.rls.validate()
     }
@@ -317,10 +292,6 @@ pub struct Adaptation<const N: usize, const NX: usize, const NP: usize> {
     phase: Phase<N, NP>,
     /// A candidate this close to the last reverted model is not tried again.
     reverted_theta: Option<SVector<f64, NP>>,
-    /// Torque the robot felt over each of the last intervals (newest
-    /// first), and the actuator's output now.
-    felt: [Vector<N>; MAX_DELAY_SAMPLES],
-    actuator: Vector<N>,
     /// The closed loop's last `judge_samples` (before a change).
     recent: Block,
     recent_done: Block,
@@ -345,6 +316,7 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
     /// Starts from the controller's model `prior` (gear ratios, gravity and
     /// the Coulomb sharpness are taken as known) and its worker thread.
     pub fn new(prior: &PlanarChainParams<N>, options: AdaptOptions) -> Result<Self, IdentifyError> {
+        options.validate()?;
         let rls = EnergyBalanceRls::new(prior, options.rls)?;
         let in_use = BaseParameters::<N, NP>::of(prior)?.theta;
         let shared = Arc::new((
@@ -372,8 +344,6 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
             in_use,
             phase: Phase::Watching,
             reverted_theta: None,
-            felt: [Vector::zeros(); MAX_DELAY_SAMPLES],
-            actuator: Vector::zeros(),
             recent: Block::default(),
             recent_done: Block::default(),
             recent_prev: Block::default(),
@@ -454,33 +424,12 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
         self.event(AdaptationEvent::Refused(reason));
     }
 
-    /// The torque the robot felt over the interval that ends at the state
-    /// measured now, from the commands: `command` was sent at the previous
-    /// sample, `dt` ago. The actuator's lag is integrated exactly for a
-    /// held command; the delay picks the interval (interpolated between
-    /// whole samples).
-    fn felt_torque(&mut self, command: &Vector<N>, dt: f64) -> Vector<N> {
-        let tc = self.options.actuator_time_constant;
-        let mean = if tc > 0.0 {
-            let decay = (-dt / tc).exp();
-            let mean = command + (self.actuator - command) * (tc / dt * (1.0 - decay));
-            self.actuator = command + (self.actuator - command) * decay;
-            mean
-        } else {
-            self.actuator = *command;
-            *command
-        };
-        self.felt.copy_within(0..MAX_DELAY_SAMPLES - 1, 1);
-        self.felt[0] = mean;
-        let delay = self.options.measurement_delay / dt;
-        let whole = (delay.floor() as usize).min(MAX_DELAY_SAMPLES - 2);
-        let part = (delay - whole as f64).clamp(0.0, 1.0);
-        self.felt[whole] * (1.0 - part) + self.felt[whole + 1] * part
-    }
-
     /// One sample, after the controller's step (with the state the step
     /// used, see the `AdaptiveController` of the FMU): `(q, qd)` measured
-    /// now, `command` the torque sent at the previous sample, `dt` ago.
+    /// now, `felt` the torque that acted over the `dt` before the
+    /// measurement ([`Controller::torque_before_measurement`]: the previous
+    /// command, or the one the declared measurement delay and actuator lag
+    /// say acted then).
     /// Feeds the identification; scores, takes or refuses a candidate;
     /// supervises a new model.
     pub fn sample(
@@ -488,13 +437,12 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
         controller: &mut Controller<PlanarChain<N>, N, NX>,
         q: &Vector<N>,
         qd: &Vector<N>,
-        command: &Vector<N>,
+        felt: &Vector<N>,
         dt: f64,
     ) {
-        let felt = self.felt_torque(command, dt);
-        let window = self.rls.add_sample(q, qd, &felt, dt);
+        let window = self.rls.add_sample(q, qd, felt, dt);
         self.samples += 1;
-        self.observe(controller, q, qd, command);
+        self.observe(controller, q, qd, felt);
         if let Some(window) = window {
             self.score(&window);
         }
@@ -888,8 +836,6 @@ pub struct AdaptationState<const N: usize, const NP: usize> {
     in_use: SVector<f64, NP>,
     phase: Phase<N, NP>,
     reverted_theta: Option<SVector<f64, NP>>,
-    felt: Vec<Vector<N>>,
-    actuator: Vector<N>,
     recent: Block,
     recent_done: Block,
     recent_prev: Block,
@@ -924,8 +870,6 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
             in_use: self.in_use,
             phase: self.phase.clone(),
             reverted_theta: self.reverted_theta,
-            felt: self.felt.to_vec(),
-            actuator: self.actuator,
             recent: self.recent,
             recent_done: self.recent_done,
             recent_prev: self.recent_prev,
@@ -945,11 +889,6 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
     /// the worker is still computing for the state before are dropped.
     pub fn restore_state(&mut self, state: AdaptationState<N, NP>) -> Result<(), IdentifyError> {
         self.rls.check_compatible(&state.rls)?;
-        if state.felt.len() != MAX_DELAY_SAMPLES {
-            return Err(IdentifyError::NotPhysical(
-                "the saved torque history has another length".into(),
-            ));
-        }
         let (lock, wake) = &*self.shared;
         let mut slot = lock.lock().unwrap_or_else(|e| e.into_inner());
         self.generation += 1;
@@ -962,8 +901,6 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
         self.in_use = state.in_use;
         self.phase = state.phase;
         self.reverted_theta = state.reverted_theta;
-        self.felt.copy_from_slice(&state.felt);
-        self.actuator = state.actuator;
         self.recent = state.recent;
         self.recent_done = state.recent_done;
         self.recent_prev = state.recent_prev;

@@ -138,8 +138,15 @@ fn a_lighter_robot_and_a_shorter_link_are_found() {
             "off: E {:.4} J, tau {:.4}; on: E {:.4} J, tau {:.4}, {} models, {:?}",
             off.energy, off.torque, on.energy, on.torque, on.models, on.status
         );
-        assert!((off.energy - e_ref).abs() > 0.05 * e_ref, "the test can fail");
-        assert!((on.energy - e_ref).abs() < 0.01 * e_ref, "energy {}", on.energy);
+        assert!(
+            (off.energy - e_ref).abs() > 0.05 * e_ref,
+            "the test can fail"
+        );
+        assert!(
+            (on.energy - e_ref).abs() < 0.01 * e_ref,
+            "energy {}",
+            on.energy
+        );
         assert!(on.torque < 0.03, "torque {}", on.torque);
         assert!(on.models > 0);
     }

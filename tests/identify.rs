@@ -190,7 +190,8 @@ fn recursive_least_squares_recovers_a_plant_the_prior_gets_wrong() {
         assert!((estimate[i] - 0.05).abs() < 0.01, "b: {}", estimate[i]);
     }
     // the mapped chain has the plant's energy along other states
-    let mapped = PlanarChain::new(rls.estimate().projected().chain_params(&prior).unwrap()).unwrap();
+    let mapped =
+        PlanarChain::new(rls.estimate().projected().chain_params(&prior).unwrap()).unwrap();
     let true_chain = PlanarChain::new(plant).unwrap();
     for (q, qd) in states::<2>() {
         let (a, b) = (mapped.energy(&q, &qd), true_chain.energy(&q, &qd));

@@ -60,7 +60,10 @@ impl<const N: usize, const NX: usize, const NP: usize> AdaptiveController<N, NX,
             let used = self.controller.state_estimate().copied().unwrap_or(*z);
             let q = Vector::<N>::from_fn(|j, _| used[j]);
             let qd = Vector::<N>::from_fn(|j, _| used[N + j]);
-            adaptation.sample(&mut self.controller, &q, &qd, &self.tau, dt);
+            // The torque that acted before the measurement (the previous
+            // command without a declared delay or lag).
+            let felt = self.controller.torque_before_measurement();
+            adaptation.sample(&mut self.controller, &q, &qd, &felt, dt);
         }
         self.tau = out.tau;
         out
