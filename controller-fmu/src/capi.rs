@@ -96,6 +96,15 @@ pub struct EigenMpcConfig {
     /// model (real-time loops); 0 (default) = the next look waits for it
     /// (reproducible offline runs). As the FMU's `adapt_realtime`.
     pub adapt_realtime: i32,
+    /// Age of the measured state when it reaches the controller (s), 0..=1
+    /// and at most horizon * sample_period; 0 (default): current. The
+    /// controller predicts it forward with the torques it sent since. As the
+    /// FMU's `measurement_delay`.
+    pub measurement_delay: f64,
+    /// Time constant of the motor's first-order lag (s), 0..=1 and at most
+    /// horizon * sample_period; 0 (default): immediate. As the FMU's
+    /// `actuator_time_constant`.
+    pub actuator_time_constant: f64,
 }
 
 /// Diagnostics of the last [`eigenmpc_step`].
@@ -198,7 +207,7 @@ impl EigenMpc {
 /// The config's fields as the controller FMU's parameters: `(C field,
 /// FMU name, value)`. The FMU's variable table checks them, so the C API
 /// and the FMU accept the same ranges.
-fn named_fields(config: &EigenMpcConfig) -> [(&'static str, &'static str, f64); 25] {
+fn named_fields(config: &EigenMpcConfig) -> [(&'static str, &'static str, f64); 27] {
     [
         ("variant", "variant", f64::from(config.variant)),
         ("e_ref", "E_ref", config.e_ref),
@@ -236,6 +245,16 @@ fn named_fields(config: &EigenMpcConfig) -> [(&'static str, &'static str, f64); 
             "adapt_realtime",
             "adapt_realtime",
             f64::from(config.adapt_realtime),
+        ),
+        (
+            "measurement_delay",
+            "measurement_delay",
+            config.measurement_delay,
+        ),
+        (
+            "actuator_time_constant",
+            "actuator_time_constant",
+            config.actuator_time_constant,
         ),
     ]
 }
@@ -325,6 +344,8 @@ pub extern "C" fn eigenmpc_config_default(variant: i32) -> EigenMpcConfig {
         adapt: i32::from(s.adapt),
         adapt_period: s.adapt_period,
         adapt_realtime: i32::from(s.adapt_realtime),
+        measurement_delay: s.measurement_delay,
+        actuator_time_constant: s.actuator_time_constant,
     }
 }
 
