@@ -99,8 +99,17 @@ pub struct EigenMpcConfig {
     /// Energy scale E_s (J), >= 0: for E_ref < E_s the energy residual is
     /// r_E = (E_ref - E) sqrt(E_s / E_ref) (default 14, where w_E was tuned;
     /// from E_s up, and with 0, the paper's E_ref - E). As the FMU's
-    /// `E_scale`; last, so that the offsets of the fields before it stay.
+    /// `E_scale`; after the older fields, so that their offsets stay.
     pub e_scale: f64,
+    /// Age of the measured state when it reaches the controller (s), 0..=1
+    /// and at most horizon * sample_period; 0 (default): current. The
+    /// controller predicts it forward with the torques it sent since. As the
+    /// FMU's `measurement_delay`.
+    pub measurement_delay: f64,
+    /// Time constant of the motor's first-order lag (s), 0..=1 and at most
+    /// horizon * sample_period; 0 (default): immediate. As the FMU's
+    /// `actuator_time_constant`.
+    pub actuator_time_constant: f64,
 }
 
 /// Diagnostics of the last [`eigenmpc_step`].
@@ -203,7 +212,7 @@ impl EigenMpc {
 /// The config's fields as the controller FMU's parameters: `(C field,
 /// FMU name, value)`. The FMU's variable table checks them, so the C API
 /// and the FMU accept the same ranges.
-fn named_fields(config: &EigenMpcConfig) -> [(&'static str, &'static str, f64); 26] {
+fn named_fields(config: &EigenMpcConfig) -> [(&'static str, &'static str, f64); 28] {
     [
         ("variant", "variant", f64::from(config.variant)),
         ("e_ref", "E_ref", config.e_ref),
@@ -243,6 +252,16 @@ fn named_fields(config: &EigenMpcConfig) -> [(&'static str, &'static str, f64); 
             f64::from(config.adapt_realtime),
         ),
         ("e_scale", "E_scale", config.e_scale),
+        (
+            "measurement_delay",
+            "measurement_delay",
+            config.measurement_delay,
+        ),
+        (
+            "actuator_time_constant",
+            "actuator_time_constant",
+            config.actuator_time_constant,
+        ),
     ]
 }
 
@@ -333,6 +352,8 @@ pub extern "C" fn eigenmpc_config_default(variant: i32) -> EigenMpcConfig {
         adapt_period: s.adapt_period,
         adapt_realtime: i32::from(s.adapt_realtime),
         e_scale: s.tuning.e_scale,
+        measurement_delay: s.measurement_delay,
+        actuator_time_constant: s.actuator_time_constant,
     }
 }
 

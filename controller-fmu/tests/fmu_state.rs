@@ -1,7 +1,8 @@
 //! FMU state of the controller: a state saved in a closed loop continues
 //! bit for bit in the same instance, in another instance and from its
-//! serialized bytes (with adaptation, the EKF and a wrong plant, so that
-//! the plan, the warm start, the filter, the identification and an adapted
+//! serialized bytes (with adaptation, the EKF, a declared measurement delay
+//! and actuator lag and a wrong plant, so that the plan, the warm start,
+//! the filter, the command history, the identification and an adapted
 //! model and family are all part of it).
 
 use eigenmpc::integrate::{Dopri5, Tolerances};
@@ -74,6 +75,11 @@ impl Loop {
             let ekf = STATE_ESTIMATOR_EKF;
             assert_eq!(fmi2SetInteger(c, &vref("state_estimator"), 1, &ekf), OK);
             assert_eq!(fmi2SetInteger(c, &vref("qp_solver"), 1, &qp_solver), OK);
+            // A declared delay (fractional) and lag: the command history
+            // is part of the state.
+            let (delay, lag) = (0.0625, 0.05);
+            assert_eq!(fmi2SetReal(c, &vref("measurement_delay"), 1, &delay), OK);
+            assert_eq!(fmi2SetReal(c, &vref("actuator_time_constant"), 1, &lag), OK);
             assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), OK);
             assert_eq!(fmi2EnterInitializationMode(c), OK);
             assert_eq!(fmi2SetReal(c, state_vrs().as_ptr(), 4, z0.as_ptr()), OK);

@@ -104,9 +104,12 @@ fn the_two_joint_controller_keeps_the_original_value_references() {
     assert_eq!(vr(&d, "estimate.A[2,2]"), (BaseType::Real, 147));
     assert_eq!(vr(&d, "estimate.cf[2]"), (BaseType::Real, 155));
     assert_eq!(vr(&d, "model_updates"), (BaseType::Integer, 8));
-    // then the energy scale (issue 19)
+    // then the energy scale, the measurement delay and the actuator lag
+    // (issue 19)
     assert_eq!(vr(&d, "E_scale"), (BaseType::Real, 156));
-    assert_eq!(d.variables.len(), 24 + 20 + 5 + 17 + 6 + 4 + 3 + 11 + 1 + 1);
+    assert_eq!(vr(&d, "measurement_delay"), (BaseType::Real, 157));
+    assert_eq!(vr(&d, "actuator_time_constant"), (BaseType::Real, 158));
+    assert_eq!(d.variables.len(), 24 + 20 + 5 + 17 + 6 + 4 + 3 + 11 + 1 + 1 + 2);
 }
 
 /// Every variable of the original `DoublePendulum.fmu` keeps its name and

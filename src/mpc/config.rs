@@ -65,7 +65,7 @@ pub struct MpcConfig {
     pub estimator: Option<EstimatorConfig>,
     /// Age of the measured state when it reaches the controller (s; 0, the
     /// default: current). The controller predicts it forward over the
-    /// delay with the torques it sent meanwhile (see [`super::delay`]);
+    /// delay with the torques it sent meanwhile (docs/delay.md);
     /// at most [`MAX_COMPENSATED_TIME`] and the horizon's length.
     pub measurement_delay: f64,
     /// Time constant `T` of the actuator's first-order lag

@@ -7,8 +7,10 @@
 //!   one interval, integrate every shooting interval with RK4 and exact
 //!   sensitivities, evaluate the residual Jacobians and write the QP in the
 //!   step variables `(dx_k, du_k)`;
-//! - **feedback** ([`Controller::feedback`]): embed the measured state as
-//!   `dx_0 = z - x_0`, solve the QP, take the full step and return `tau_0`.
+//! - **feedback** ([`Controller::feedback`]): embed the measured state
+//!   (predicted over a declared measurement delay and actuator lag, a few
+//!   RK4 steps, `src/mpc/delay.rs`) as `dx_0 = z - x_0`, solve the QP,
+//!   take the full step and return `tau_0`.
 //!
 //! Optionally several iterations per sample, and a converged SQP with an
 //! L1-merit backtracking line search ([`Controller::solve_to_convergence`]),
@@ -343,7 +345,7 @@ where
     /// or before the first sample): the filtered state **at the time the
     /// measurement was taken**, `measurement_delay` before the sample.
     /// That is what an identification pairs with the torque acting then
-    /// (the command `measurement_delay` earlier); the state the plan
+    /// ([`Controller::torque_before_measurement`]); the state the plan
     /// started from is [`Controller::predicted_current_state`].
     pub fn state_estimate(&self) -> Option<&SVector<f64, NX>> {
         self.estimator.as_ref().and_then(|e| e.estimate())

@@ -119,6 +119,18 @@ pub struct SimulateArgs {
     /// `0.05,0.05,0.3`.
     #[arg(long, value_name = "ANGLE,SPEED,ACCEL")]
     ekf: Option<String>,
+    /// Plant side: the controller sees the state of this many samples ago
+    /// (before t = 0: the initial state).
+    #[arg(long, default_value_t = 0)]
+    delay_samples: usize,
+    /// Controller: the age of the measurement it gets (s), predicted forward
+    /// with the torques it sent since (0: none; at most 1 s and N dt).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    measurement_delay: f64,
+    /// Controller: time constant of the motor's first-order lag (s; 0: none;
+    /// at most 1 s and N dt).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    actuator_time_constant: f64,
     #[command(flatten)]
     model: ModelArgs,
 }
@@ -259,6 +271,8 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
     config.cost.alpha = args.alpha;
     config.cost.beta = args.beta;
     config.cost.compensate_friction = !args.no_friction_compensation;
+    config.measurement_delay = args.measurement_delay;
+    config.actuator_time_constant = args.actuator_time_constant;
     if let Some(text) = &args.ekf {
         let levels = super::parse_list("ekf", text)?;
         let [angle_noise, speed_noise, acceleration_noise] = levels[..] else {
@@ -339,6 +353,9 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
     let z0 = SVector::<f64, 4>::from_column_slice(&x0);
     let mut next = 0;
     let mut noise = GaussianNoise::new(args.seed);
+    // Before the first sample the plant rested at z0.
+    let mut history: std::collections::VecDeque<SVector<f64, 4>> =
+        std::iter::repeat_n(z0, args.delay_samples).collect();
     let trace = run_measured(
         &mut controller,
         &plant,
@@ -352,10 +369,12 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
             }
         },
         |_, z| {
+            history.push_back(*z);
+            let seen = history.pop_front().unwrap_or(*z);
             if args.noise > 0.0 {
-                noise.measure(z, args.noise, args.noise)
+                noise.measure(&seen, args.noise, args.noise)
             } else {
-                *z
+                seen
             }
         },
     )?;

@@ -19,8 +19,6 @@ pub struct AdaptiveController<const N: usize, const NX: usize, const NP: usize> 
     /// Base parameters of the model the controller was built with (None:
     /// a model with joint springs has none).
     prior: Option<BaseParameters<N, NP>>,
-    /// Torque of the previous sample (applied since then).
-    tau: Vector<N>,
 }
 
 impl<const N: usize, const NX: usize, const NP: usize> AdaptiveController<N, NX, NP> {
@@ -44,14 +42,14 @@ impl<const N: usize, const NX: usize, const NP: usize> AdaptiveController<N, NX,
             controller,
             adaptation,
             prior,
-            tau: Vector::zeros(),
         })
     }
 
     /// One sample at state `z`, `dt` seconds after the previous one:
     /// solves, then feeds the identification with the state the solve used
-    /// (the state estimate with `state_estimator = ekf`, else `z`) and the
-    /// torque applied since the previous sample, and takes a ready model
+    /// (the state estimate with `state_estimator = ekf`, else `z`; at the
+    /// measurement's time) and the torque that acted over the sample
+    /// before the measurement, and takes a ready model
     /// for the next sample. Allocation-free; waits for the worker only
     /// without `adapt_realtime` (offline simulation).
     pub fn step(&mut self, z: &SVector<f64, NX>, dt: f64) -> ControlOutput<N> {
@@ -65,7 +63,6 @@ impl<const N: usize, const NX: usize, const NP: usize> AdaptiveController<N, NX,
             let felt = self.controller.torque_before_measurement();
             adaptation.sample(&mut self.controller, &q, &qd, &felt, dt);
         }
-        self.tau = out.tau;
         out
     }
 
@@ -77,7 +74,6 @@ impl<const N: usize, const NX: usize, const NP: usize> AdaptiveController<N, NX,
         if let Some(adaptation) = &mut self.adaptation {
             adaptation.restart_window();
         }
-        self.tau = Vector::zeros();
     }
 
     /// The controller.
@@ -104,7 +100,6 @@ impl<const N: usize, const NX: usize, const NP: usize> AdaptiveController<N, NX,
         AdaptiveState {
             controller: self.controller.save_state(),
             adaptation: self.adaptation.as_ref().map(|a| a.save_state()),
-            tau: self.tau,
         }
     }
 
@@ -133,7 +128,6 @@ impl<const N: usize, const NX: usize, const NP: usize> AdaptiveController<N, NX,
             }
             return Err(e.to_string());
         }
-        self.tau = state.tau;
         Ok(())
     }
 
@@ -148,5 +142,4 @@ impl<const N: usize, const NX: usize, const NP: usize> AdaptiveController<N, NX,
 pub struct AdaptiveState<const N: usize, const NX: usize, const NP: usize> {
     controller: ControllerState<PlanarChain<N>, N, NX>,
     adaptation: Option<AdaptationState<N, NP>>,
-    tau: Vector<N>,
 }

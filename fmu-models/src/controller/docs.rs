@@ -38,6 +38,12 @@ paper's <code>E_ref - E</code>.</p>\
 iterate); 2 QP failed: the torque is the fallback (the previous plan's next control, clipped) \
 and a warning is logged. Code 3 (invalid state) belongs to the C API: this FMU refuses NaN/Inf \
 inputs with fmi2Error before any solve.</p>\
+<p><b>Delay and lag.</b> <code>measurement_delay</code> (s) declares the age of the measured \
+state when it arrives: the controller predicts it forward with its model and the torques it \
+sent since (the state estimator filters it at its own time). <code>actuator_time_constant</code> \
+(s) declares a first-order lag of the motor: integrated exactly over the delay, taken as a dead \
+time over the horizon. A declared delay of 4 samples or lag of 2 costs nothing measurable on the \
+paper's scenario (docs/delay.md).</p>\
 <p><b>Refused values.</b> A value out of range (or NaN/Inf) is refused with fmi2Error; the old \
 value stays in place and readable, and the instance is in the FMI error state: call \
 fmi2Reset to continue.</p>"

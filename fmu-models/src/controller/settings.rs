@@ -153,6 +153,12 @@ pub struct Settings<const N: usize> {
     /// closed loop depends on the machine's speed). Off: the next look
     /// waits for it, and every run gives the same numbers.
     pub adapt_realtime: bool,
+    /// Age of the measured state when it arrives (s; see
+    /// [`MpcConfig::measurement_delay`]).
+    pub measurement_delay: f64,
+    /// Time constant of the actuator's first-order lag (s; see
+    /// [`MpcConfig::actuator_time_constant`]).
+    pub actuator_time_constant: f64,
 }
 
 impl<const N: usize> HasChain<N> for Settings<N> {
@@ -199,6 +205,8 @@ impl<const N: usize> Settings<N> {
             adapt: false,
             adapt_period: 1.0,
             adapt_realtime: false,
+            measurement_delay: config.measurement_delay,
+            actuator_time_constant: config.actuator_time_constant,
         }
     }
 
@@ -224,6 +232,8 @@ impl<const N: usize> Settings<N> {
             StateEstimator::None => None,
             StateEstimator::Ekf => Some(self.noise),
         };
+        config.measurement_delay = self.measurement_delay;
+        config.actuator_time_constant = self.actuator_time_constant;
         config
     }
 

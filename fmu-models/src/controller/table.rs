@@ -251,7 +251,41 @@ pub fn table<const N: usize>() -> Table<Settings<N>> {
         )
         .unit("J"),
     );
+    rows.extend(compensation_rows::<N>());
     Table::new(N, rows)
+}
+
+/// The rows of the measurement delay and actuator lag the controller
+/// compensates.
+fn compensation_rows<const N: usize>() -> Vec<Rw<N>> {
+    vec![
+        Rw::<N>::real("measurement_delay", Shape::Scalar)
+            .parameter(Field::real(
+                |s, _| s.measurement_delay,
+                |s, _, v| s.measurement_delay = v,
+            ))
+            .unit("s")
+            .range(0.0, eigenmpc::mpc::MAX_COMPENSATED_TIME)
+            .describe(
+                "Age of the measured q, qd when they reach the controller (0: current; at most \
+                 1 s and horizon sample_period). The controller predicts them forward with \
+                 its model and the torques it sent since (any delay, whole samples or not); \
+                 the state estimator filters them at their own time",
+            ),
+        Rw::<N>::real("actuator_time_constant", Shape::Scalar)
+            .parameter(Field::real(
+                |s, _| s.actuator_time_constant,
+                |s, _, v| s.actuator_time_constant = v,
+            ))
+            .unit("s")
+            .range(0.0, eigenmpc::mpc::MAX_COMPENSATED_TIME)
+            .describe(
+                "Time constant T of the motor's first-order lag dtau_applied/dt = (tau - \
+                 tau_applied) / T (0: immediate; at most 1 s and horizon sample_period). \
+                 Integrated exactly over the measurement delay; over the horizon taken as a \
+                 dead time of T (the plan starts at the state predicted T ahead)",
+            ),
+    ]
 }
 
 /// Names of the estimated base-parameter rows, in the order of
