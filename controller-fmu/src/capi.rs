@@ -26,7 +26,7 @@ use eigenmpc_fmu_models::controller::ControllerProduct;
 use eigenmpc_fmu_models::controller::adaptive::AdaptiveController;
 use eigenmpc_fmu_models::controller::named::{check_named, settings_from_named};
 use eigenmpc_fmu_models::controller::settings::{ChartSource, Settings, Tuning};
-use eigenmpc_fmu_models::enums::{CHART_SOURCE, QP_SOLVER};
+use eigenmpc_fmu_models::enums::{ADAPTATION_STATUS, CHART_SOURCE, QP_SOLVER};
 use eigenmpc_fmu_models::products::{EigenMpc2, EigenMpc3};
 use nalgebra::SVector;
 use std::ffi::{CStr, CString, c_char};
@@ -127,6 +127,14 @@ pub struct EigenMpcStepInfo {
     pub energy: f64,
     /// Models taken from the identification so far (0 without adaptation).
     pub model_updates: u32,
+    /// Candidate models the adaptation refused so far (as the FMU's
+    /// `adapt_refused`).
+    pub adapt_refused: u32,
+    /// Models the adaptation's supervisor took back (as `adapt_reverts`).
+    pub adapt_reverts: u32,
+    /// What the adaptation is doing: the FMU's `adaptation_status` item (1
+    /// idle, 2 excitation, 3 learning, 4 converged, 5 reverted).
+    pub adaptation_status: i32,
 }
 
 /// The controller behind a handle, whatever its number of joints.
@@ -171,6 +179,9 @@ impl<const N: usize, const NX: usize, const NP: usize> JointController
             solve_time: out.preparation_time + out.feedback_time,
             energy,
             model_updates: u32::try_from(self.model_updates()).unwrap_or(u32::MAX),
+            adapt_refused: u32::try_from(self.refused_models()).unwrap_or(u32::MAX),
+            adapt_reverts: u32::try_from(self.reverted_models()).unwrap_or(u32::MAX),
+            adaptation_status: ADAPTATION_STATUS.item(self.adaptation_status()),
         }
     }
 

@@ -164,10 +164,16 @@ fn a_saved_controller_continues_bit_for_bit_here_elsewhere_and_from_bytes() {
 }
 
 fn continues_bit_for_bit(qp_solver: i32) {
+    // When the first model is taken (after the climb): the state is saved
+    // a second before, while that candidate is validated and its model
+    // computed (a request in flight).
+    let taken = Loop::start(qp_solver)
+        .run(1600)
+        .iter()
+        .position(|s| s.1 > 0)
+        .expect("a model is taken within 40 s");
     let mut first = Loop::start(qp_solver);
-    // 1.5 s: between two looks of the adaptation (adapt_period 1 s), with
-    // a request in flight.
-    first.run(60);
+    first.run(taken - 40);
     let saved = first.save();
     let (t, ode) = (first.t, first.ode.clone());
     let reference = first.run(240);

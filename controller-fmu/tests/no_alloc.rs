@@ -174,6 +174,9 @@ fn c_api_step_does_not_allocate() {
             solve_time: 0.0,
             energy: f64::NAN,
             model_updates: 0,
+            adapt_refused: 0,
+            adapt_reverts: 0,
+            adaptation_status: 0,
         };
         for k in 0..SAMPLES {
             let ((status, last), n) = counted(|| {

@@ -3,6 +3,7 @@
 //! tables, the C API and the C header.
 
 use crate::controller::settings::{ChartSource, StateEstimator};
+use eigenmpc::adapt::AdaptationStatus;
 use eigenmpc::mpc::{QpBackend, Variant};
 use fmi2_slave::EnumerationType;
 
@@ -160,6 +161,44 @@ pub const STATE_ESTIMATOR: Enumeration<StateEstimator> = Enumeration {
     ],
 };
 
+/// `adaptation_status`: what the online adaptation is doing (an output).
+pub const ADAPTATION_STATUS: Enumeration<AdaptationStatus> = Enumeration {
+    type_name: "AdaptationStatus",
+    parameter: "adaptation_status",
+    items: &[
+        Item {
+            name: "idle",
+            item: 1,
+            value: AdaptationStatus::Idle,
+            description: "adapt = false, or no window has informed the estimate yet",
+        },
+        Item {
+            name: "excitation",
+            item: 2,
+            value: AdaptationStatus::Excitation,
+            description: "Gathering the information the estimate lacks",
+        },
+        Item {
+            name: "learning",
+            item: 3,
+            value: AdaptationStatus::Learning,
+            description: "Estimating; a candidate model is validated or a new model supervised",
+        },
+        Item {
+            name: "converged",
+            item: 4,
+            value: AdaptationStatus::Converged,
+            description: "The estimate agrees with the model in use",
+        },
+        Item {
+            name: "reverted",
+            item: 5,
+            value: AdaptationStatus::Reverted,
+            description: "The supervisor took the last model back (the loop did worse with it)",
+        },
+    ],
+};
+
 /// `variant` item: straight EigenMPC.
 pub const VARIANT_STRAIGHT: i32 = VARIANT.items[0].item;
 /// `variant` item: curved EigenMPC.
@@ -201,6 +240,15 @@ mod tests {
             assert_eq!(STATE_ESTIMATOR.value(STATE_ESTIMATOR.item(e)), Ok(e));
         }
         assert_eq!((STATE_ESTIMATOR_NONE, STATE_ESTIMATOR_EKF), (1, 2));
+        for a in [
+            AdaptationStatus::Idle,
+            AdaptationStatus::Excitation,
+            AdaptationStatus::Learning,
+            AdaptationStatus::Converged,
+            AdaptationStatus::Reverted,
+        ] {
+            assert_eq!(ADAPTATION_STATUS.value(ADAPTATION_STATUS.item(a)), Ok(a));
+        }
         assert_eq!(VARIANT_HYBRID, 3);
         assert_eq!(
             VARIANT.value(4),

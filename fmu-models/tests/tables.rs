@@ -109,7 +109,14 @@ fn the_two_joint_controller_keeps_the_original_value_references() {
     assert_eq!(vr(&d, "E_scale"), (BaseType::Real, 156));
     assert_eq!(vr(&d, "measurement_delay"), (BaseType::Real, 157));
     assert_eq!(vr(&d, "actuator_time_constant"), (BaseType::Real, 158));
-    assert_eq!(d.variables.len(), 24 + 20 + 5 + 17 + 6 + 4 + 3 + 11 + 1 + 1 + 2);
+    // then what the adaptation did
+    assert_eq!(vr(&d, "adapt_refused"), (BaseType::Integer, 9));
+    assert_eq!(vr(&d, "adapt_reverts"), (BaseType::Integer, 10));
+    assert_eq!(vr(&d, "adaptation_status"), (BaseType::Integer, 11));
+    assert_eq!(
+        d.variables.len(),
+        24 + 20 + 5 + 17 + 6 + 4 + 3 + 11 + 1 + 1 + 2 + 3
+    );
 }
 
 /// Every variable of the original `DoublePendulum.fmu` keeps its name and

@@ -3,7 +3,7 @@
 //! the same way.
 
 use super::settings::{ChainController, Settings};
-use eigenmpc::adapt::{Adaptation, AdaptationState};
+use eigenmpc::adapt::{Adaptation, AdaptationEvent, AdaptationState, AdaptationStatus};
 use eigenmpc::identify::BaseParameters;
 use eigenmpc::mechanics::PlanarChain;
 use eigenmpc::mechanics::Vector;
@@ -129,6 +129,29 @@ impl<const N: usize, const NX: usize, const NP: usize> AdaptiveController<N, NX,
             return Err(e.to_string());
         }
         Ok(())
+    }
+
+    /// Candidates the adaptation refused so far (0 without `adapt`).
+    pub fn refused_models(&self) -> usize {
+        self.adaptation.as_ref().map_or(0, |a| a.refused())
+    }
+
+    /// Models the adaptation's supervisor took back (0 without `adapt`).
+    pub fn reverted_models(&self) -> usize {
+        self.adaptation.as_ref().map_or(0, |a| a.reverts())
+    }
+
+    /// What the adaptation is doing (idle without `adapt`).
+    pub fn adaptation_status(&self) -> AdaptationStatus {
+        self.adaptation
+            .as_ref()
+            .map_or(AdaptationStatus::Idle, |a| a.status())
+    }
+
+    /// The adaptation's latest event and its number (None: none yet, or no
+    /// `adapt`).
+    pub fn adaptation_event(&self) -> Option<(usize, AdaptationEvent)> {
+        self.adaptation.as_ref().and_then(|a| a.last_event())
     }
 
     /// Models taken from the identification so far (0 without `adapt`).

@@ -23,8 +23,10 @@ pub mod start_values;
 pub mod table;
 pub mod timing;
 
+use crate::enums::ADAPTATION_STATUS;
 use crate::units;
 use adaptive::AdaptiveController;
+use eigenmpc::adapt::AdaptationEvent;
 use eigenmpc::mpc::{ControlOutput, MpcConfig, Variant};
 use fmi2_slave::table::{Element, Table};
 use fmi2_slave::{Context, DefaultExperiment, Model, ModelDescription, ModelError, Values};
@@ -70,6 +72,9 @@ struct Io<const N: usize> {
     /// The base-parameter outputs, in the estimate's order (`NP`).
     estimate: Vec<u32>,
     model_updates: u32,
+    adapt_refused: u32,
+    adapt_reverts: u32,
+    adaptation_status: u32,
 }
 
 impl<const N: usize> Io<N> {
@@ -104,6 +109,9 @@ impl<const N: usize> Io<N> {
             ],
             estimate,
             model_updates: scalar("model_updates")?,
+            adapt_refused: scalar("adapt_refused")?,
+            adapt_reverts: scalar("adapt_reverts")?,
+            adaptation_status: scalar("adaptation_status")?,
         })
     }
 }
@@ -116,6 +124,10 @@ pub struct ControllerFmu<P, const N: usize, const NX: usize, const NP: usize> {
     solved_at: f64,
     /// Model updates already reported.
     updates_reported: usize,
+    /// Adaptation events already logged, and the refusal reasons logged
+    /// (each once; later ones are counted in `adapt_refused`).
+    events_logged: usize,
+    refusals_logged: [bool; 3],
     /// Solves that did not succeed (logged: the first and every
     /// [`FAILURE_LOG_EVERY`]-th).
     failed_solves: usize,
@@ -135,6 +147,8 @@ struct SavedController<const N: usize, const NX: usize, const NP: usize> {
     controller: adaptive::AdaptiveState<N, NX, NP>,
     solved_at: f64,
     updates_reported: usize,
+    events_logged: usize,
+    refusals_logged: [bool; 3],
     failed_solves: usize,
     clock: SampleClock,
     solved_state: SVector<f64, NX>,
@@ -198,6 +212,8 @@ impl<P: ControllerProduct<N> + Send, const N: usize, const NX: usize, const NP: 
             controller,
             solved_at: ctx.experiment.start_time,
             updates_reported: 0,
+            events_logged: 0,
+            refusals_logged: [false; 3],
             failed_solves: 0,
             clock: SampleClock::new(ctx.experiment.start_time, settings.sample_period),
             settings,
@@ -235,6 +251,8 @@ impl<P: ControllerProduct<N> + Send, const N: usize, const NX: usize, const NP: 
             controller: self.controller.save_state(),
             solved_at: self.solved_at,
             updates_reported: self.updates_reported,
+            events_logged: self.events_logged,
+            refusals_logged: self.refusals_logged,
             failed_solves: self.failed_solves,
             clock: self.clock.clone(),
             solved_state: self.solved_state,
@@ -262,6 +280,8 @@ impl<P: ControllerProduct<N> + Send, const N: usize, const NX: usize, const NP: 
         self.settings = settings;
         self.solved_at = saved.solved_at;
         self.updates_reported = saved.updates_reported;
+        self.events_logged = saved.events_logged;
+        self.refusals_logged = saved.refusals_logged;
         self.failed_solves = saved.failed_solves;
         self.clock = saved.clock;
         self.solved_state = saved.solved_state;
@@ -353,6 +373,7 @@ impl<P, const N: usize, const NX: usize, const NP: usize> ControllerFmu<P, N, NX
         }
         let energy = self.controller.controller().energy(&z);
         self.write_outputs(values, &out, energy);
+        self.log_adaptation(ctx, t);
         let updates = self.controller.model_updates();
         if updates != self.updates_reported {
             // A new model and family: their chart range (no message, no
@@ -377,10 +398,69 @@ impl<P, const N: usize, const NX: usize, const NP: usize> ControllerFmu<P, N, NX
         for (i, vr) in self.io.estimate.iter().enumerate() {
             values.set_real(*vr, estimate.map_or(0.0, |p| p.theta[i]));
         }
+        let count = |n: usize| i32::try_from(n).unwrap_or(i32::MAX);
         values.set_integer(
             self.io.model_updates,
-            i32::try_from(self.controller.model_updates()).unwrap_or(i32::MAX),
+            count(self.controller.model_updates()),
         );
+        values.set_integer(
+            self.io.adapt_refused,
+            count(self.controller.refused_models()),
+        );
+        values.set_integer(
+            self.io.adapt_reverts,
+            count(self.controller.reverted_models()),
+        );
+        values.set_integer(
+            self.io.adaptation_status,
+            ADAPTATION_STATUS.item(self.controller.adaptation_status()),
+        );
+    }
+
+    /// Logs the adaptation's new event under logEvents (OK level: the FMU
+    /// did what it documents): an accepted model and each revert with its
+    /// figures, each refusal reason the first time (then counted in
+    /// `adapt_refused`). Only when something happened: a message allocates.
+    fn log_adaptation(&mut self, ctx: &Context, t: f64) {
+        let Some((number, event)) = self.controller.adaptation_event() else {
+            return;
+        };
+        if number == self.events_logged {
+            return;
+        }
+        self.events_logged = number;
+        let message = match event {
+            AdaptationEvent::Accepted {
+                improvement,
+                windows,
+            } => format!(
+                "t = {t} s: adaptation took a new model (it explained {windows} windows \
+                 measured after it better by {improvement:.1} in units of their variance)"
+            ),
+            AdaptationEvent::Refused(reason) => {
+                let logged = &mut self.refusals_logged[reason as usize];
+                if *logged {
+                    return;
+                }
+                *logged = true;
+                format!(
+                    "t = {t} s: adaptation refused a candidate model: {}; further refusals \
+                     for this reason are counted in adapt_refused",
+                    reason.describe()
+                )
+            }
+            AdaptationEvent::Reverted {
+                torque_before,
+                torque_after,
+                energy_before,
+                energy_after,
+            } => format!(
+                "t = {t} s: adaptation reverted to the previous model: with the new one the \
+                 RMS torque went {torque_before:.4} -> {torque_after:.4} N.m and the RMS \
+                 energy error {energy_before:.4} -> {energy_after:.4} J"
+            ),
+        };
+        ctx.log.event(&message);
     }
 
     /// The controller (diagnostics and tests).

@@ -21,7 +21,7 @@
 
 use super::settings::{CHART_COEFFICIENTS, Settings};
 use crate::chain::{point_mass_rows, rigid_rows};
-use crate::enums::{CHART_SOURCE, QP_SOLVER, STATE_ESTIMATOR, VARIANT};
+use crate::enums::{ADAPTATION_STATUS, CHART_SOURCE, QP_SOLVER, STATE_ESTIMATOR, VARIANT};
 use fmi2_slave::table::{Deps, Field, Row, Shape, Table};
 
 /// Group tag of the reference rows (`E_ref`, `c[j]`, `chart.coef[j,k]`),
@@ -252,6 +252,7 @@ pub fn table<const N: usize>() -> Table<Settings<N>> {
         .unit("J"),
     );
     rows.extend(compensation_rows::<N>());
+    rows.extend(adaptation_outcome_rows::<N>());
     Table::new(N, rows)
 }
 
@@ -285,6 +286,30 @@ fn compensation_rows<const N: usize>() -> Vec<Rw<N>> {
                  Integrated exactly over the measurement delay; over the horizon taken as a \
                  dead time of T (the plan starts at the state predicted T ahead)",
             ),
+    ]
+}
+
+/// What the online adaptation did (after the older rows: their value
+/// references stay).
+fn adaptation_outcome_rows<const N: usize>() -> Vec<Rw<N>> {
+    vec![
+        Rw::<N>::integer("adapt_refused", Shape::Scalar)
+            .output()
+            .describe(
+                "Candidate models the adaptation refused: not physical, not better than the                  model in use on the windows measured after them, or no model or family                  (each reason logged once under logEvents, then counted here)",
+            ),
+        Rw::<N>::integer("adapt_reverts", Shape::Scalar)
+            .output()
+            .describe(
+                "Models the adaptation's supervisor took back because the loop did worse with                  them (torque or energy error up; each logged under logEvents)",
+            ),
+        Rw::<N>::enumeration(
+            ADAPTATION_STATUS.parameter,
+            Shape::Scalar,
+            ADAPTATION_STATUS.fmi_type(),
+        )
+        .output()
+        .describe("What the online adaptation is doing (idle with adapt = false)"),
     ]
 }
 
