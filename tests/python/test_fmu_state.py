@@ -70,8 +70,17 @@ def continue_in_this_process(paths, times, steps):
 def test_a_saved_closed_loop_continues_bit_for_bit(
     controller_md, controller_unzipped, plant_md, plant_unzipped, tmp_path
 ):
+    # The first model is taken after the climb: find when, then save a
+    # second before, while that candidate is validated and its model
+    # computed (a request in flight).
     ctrl, plant = start_pair(controller_md, controller_unzipped, plant_md, plant_unzipped)
-    run(ctrl, plant, 60)  # 1.5 s: a model request of the adaptation in flight
+    probe = run(ctrl, plant, 2400)
+    ctrl.free()
+    plant.free()
+    taken = int(np.argmax(probe[:, -1] > 0))
+    assert probe[taken, -1] > 0, "a model is taken within 60 s"
+    ctrl, plant = start_pair(controller_md, controller_unzipped, plant_md, plant_unzipped)
+    run(ctrl, plant, taken - 40)
     saved = (ctrl.fmu.getFMUstate(), plant.fmu.getFMUstate())
     times = (ctrl.time, plant.time)
     reference = run(ctrl, plant, 240)
