@@ -296,12 +296,15 @@ fn adaptation_outcome_rows<const N: usize>() -> Vec<Rw<N>> {
         Rw::<N>::integer("adapt_refused", Shape::Scalar)
             .output()
             .describe(
-                "Candidate models the adaptation refused: not physical, not better than the                  model in use on the windows measured after them, or no model or family                  (each reason logged once under logEvents, then counted here)",
+                "Candidate models the adaptation refused: not physical, not better than the \
+                 model in use on the windows measured after them, or no model or family \
+                 (each reason logged once under logEvents, then counted here)",
             ),
         Rw::<N>::integer("adapt_reverts", Shape::Scalar)
             .output()
             .describe(
-                "Models the adaptation's supervisor took back because the loop did worse with                  them (torque or energy error up; each logged under logEvents)",
+                "Models the adaptation's supervisor took back because the loop did worse with \
+                 them (torque or energy error up; each logged under logEvents)",
             ),
         Rw::<N>::enumeration(
             ADAPTATION_STATUS.parameter,
@@ -344,7 +347,11 @@ fn adaptation_rows<const N: usize>() -> Vec<Rw<N>> {
                  gravity amplitudes, rotor inertias, viscous and Coulomb friction) from the \
                  measured motion and the torque applied, by the energy balance; the model, its \
                  energy and its mode family follow the estimate (new family computed on a \
-                 worker thread). Needs a model without joint springs",
+                 worker thread). A new model is taken only from a steady loop, when it is \
+                 physical, within 30 % of the model in use and explains the windows measured \
+                 after it better; a supervisor takes it back when the loop does worse \
+                 (adapt_refused, adapt_reverts, adaptation_status). Needs a model without \
+                 joint springs",
             ),
         Rw::<N>::real("adapt_period", Shape::Scalar)
             .parameter(Field::real(
