@@ -35,6 +35,7 @@ def test_model_description(controller_md):
         "estimate.A[1,1]", "estimate.A[1,2]", "estimate.A[2,2]", "estimate.G[1]", "estimate.G[2]",
         "estimate.Ir[1]", "estimate.Ir[2]", "estimate.b[1]", "estimate.b[2]",
         "estimate.cf[1]", "estimate.cf[2]", "model_updates",
+        "adapt_refused", "adapt_reverts", "adaptation_status",
     ]
     assert v["adapt"].type == "Boolean" and v["adapt"].start == "false"
     assert v["adapt_realtime"].type == "Boolean" and v["adapt_period"].unit == "s"
