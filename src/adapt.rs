@@ -302,10 +302,6 @@ pub struct Adaptation<const N: usize, const NX: usize, const NP: usize> {
     recent: Block,
     recent_done: Block,
     recent_prev: Block,
-    /// Energy features summed over the current block, and their mean over
-    /// the last complete one (the recent orbit).
-    recent_features: SVector<f64, NP>,
-    orbit_features: SVector<f64, NP>,
     /// Answers to requests of another generation are dropped: a restored
     /// state ([`Adaptation::restore_state`]) starts a new one.
     generation: u64,
@@ -357,8 +353,6 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
             recent: Block::default(),
             recent_done: Block::default(),
             recent_prev: Block::default(),
-            recent_features: SVector::zeros(),
-            orbit_features: SVector::zeros(),
             generation: 0,
             samples: 0,
             hold_until: 0,
@@ -482,10 +476,7 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
         let t2 = command.norm_squared();
         let judge = self.options.judge_samples;
         self.recent.add(t2, e2);
-        self.recent_features += features;
         if self.recent.samples >= judge {
-            self.orbit_features = self.recent_features / self.recent.samples as f64;
-            self.recent_features.fill(0.0);
             self.recent_prev = std::mem::replace(&mut self.recent_done, self.recent);
             self.recent = Block::default();
         }
@@ -866,8 +857,6 @@ pub struct AdaptationState<const N: usize, const NP: usize> {
     recent: Block,
     recent_done: Block,
     recent_prev: Block,
-    recent_features: SVector<f64, NP>,
-    orbit_features: SVector<f64, NP>,
     samples: usize,
     hold_until: usize,
     updates: usize,
@@ -902,8 +891,6 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
             recent: self.recent,
             recent_done: self.recent_done,
             recent_prev: self.recent_prev,
-            recent_features: self.recent_features,
-            orbit_features: self.orbit_features,
             samples: self.samples,
             hold_until: self.hold_until,
             updates: self.updates,
@@ -935,8 +922,6 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
         self.recent = state.recent;
         self.recent_done = state.recent_done;
         self.recent_prev = state.recent_prev;
-        self.recent_features = state.recent_features;
-        self.orbit_features = state.orbit_features;
         self.samples = state.samples;
         self.hold_until = state.hold_until;
         self.updates = state.updates;
