@@ -104,8 +104,13 @@ impl Imperfections {
 /// (0 without) and the models it swapped in.
 #[derive(Clone, Debug)]
 pub struct ImperfectRun<const N: usize, const NX: usize> {
-    /// Per sample: the true state, the applied torque, the plant's energy.
+    /// Per sample: the true state, the applied torque (the motor's with
+    /// the torque noise, without the disturbance), the plant's energy.
     pub samples: Vec<Sample<N, NX>>,
+    /// Per sample: the motor's torque without the torque noise (the
+    /// command after the motor's response): the effort the controller
+    /// causes, which noise and disturbances do not.
+    pub motor_torque: Vec<Vector<N>>,
     /// Wall time of `Adaptation::sample` per sample (s).
     pub adaptation_time: Vec<f64>,
     /// Models the adaptation swapped in.
@@ -152,6 +157,7 @@ pub fn run_imperfect_disturbed<const N: usize, const NX: usize, const NP: usize>
     let steps = (duration / dt).round() as usize;
     let mut samples = Vec::with_capacity(steps + 1);
     let mut adaptation_time = Vec::with_capacity(steps + 1);
+    let mut motor_torque = Vec::with_capacity(steps + 1);
     let tol = Tolerances {
         rtol: 1e-10,
         atol: 1e-10,
@@ -197,6 +203,7 @@ pub fn run_imperfect_disturbed<const N: usize, const NX: usize, const NP: usize>
         }
         adaptation_time.push(started.elapsed().as_secs_f64());
         applied = out.tau * a + applied * (1.0 - a);
+        motor_torque.push(applied);
         let mut torque = applied;
         if imperfections.torque_noise > 0.0 {
             for j in 0..N {
@@ -227,6 +234,7 @@ pub fn run_imperfect_disturbed<const N: usize, const NX: usize, const NP: usize>
     }
     Ok(ImperfectRun {
         samples,
+        motor_torque,
         adaptation_time,
         model_updates: adaptation.map_or(0, |a| a.model_updates()),
     })
@@ -292,6 +300,16 @@ mod tests {
             run_imperfect::<2, 4, 11>(&mut controller(), None, &plant, &z0, 1.0, &lag).unwrap();
         // same first command (same state), half of it applied
         assert_eq!(lagged.samples[0].tau, plain.samples[0].tau * 0.5);
+        assert_eq!(lagged.motor_torque[0], lagged.samples[0].tau);
+        // torque noise is in what the plant got, not in the motor's torque
+        let noisy = Imperfections {
+            torque_noise: 0.1,
+            ..Imperfections::default()
+        };
+        let noisy =
+            run_imperfect::<2, 4, 11>(&mut controller(), None, &plant, &z0, 1.0, &noisy).unwrap();
+        assert_eq!(noisy.motor_torque[0], plain.samples[0].tau);
+        assert!((noisy.samples[0].tau - plain.samples[0].tau).norm() > 1e-3);
         // a delayed controller's first samples see z0: the same command as
         // the undelayed one at t = 0, while the plant has moved
         let delayed = Imperfections {

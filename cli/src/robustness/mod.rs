@@ -22,7 +22,9 @@ pub mod report;
 use eigenmpc::adapt::Adaptation;
 use eigenmpc::mechanics::{PlanarChain, PlanarChainParams, Vector};
 use eigenmpc::mpc::Variant;
-use eigenmpc::mpc::closed_loop::{GaussianNoise, energy_tail, rms_friction_torque, summarise};
+use eigenmpc::mpc::closed_loop::{
+    GaussianNoise, Sample, energy_tail, rms_friction_torque, summarise,
+};
 use eigenmpc::robustness::{Imperfections, run_imperfect_disturbed};
 use eigenmpc_fmu_models::chain::ChainParameters;
 use eigenmpc_fmu_models::controller::ControllerProduct;
@@ -473,7 +475,9 @@ pub struct Outcome {
     pub time_to_band: Option<f64>,
     /// Mean plant energy over the last 5 s minus `E_ref`, relative.
     pub energy_error: f64,
-    /// RMS motor torque over the last 5 s, per joint (N m).
+    /// RMS motor torque over the last 5 s, per joint (N m): the command
+    /// after the motor's response, without torque noise or pulses (the
+    /// controller's effort, not what the set-up adds to it).
     pub rms_torque: [f64; 2],
     /// RMS friction torque of the plant along the last 5 s, per joint (N m).
     pub friction_torque: [f64; 2],
@@ -492,6 +496,23 @@ pub struct Outcome {
 pub fn succeeds(energy_error: f64, rms_torque: [f64; 2], friction_torque: [f64; 2]) -> bool {
     energy_error.abs() <= ENERGY_TOLERANCE
         && (0..2).all(|j| rms_torque[j] <= friction_torque[j] + TORQUE_ALLOWANCE)
+}
+
+/// RMS per joint of `torque` over the samples of the last `window` s of
+/// `samples` (the window of [`summarise`]).
+fn rms_tail(samples: &[Sample<2, 4>], torque: &[Vector<2>], window: f64) -> [f64; 2] {
+    let t_end = samples.last().map_or(0.0, |s| s.time);
+    let mut sum = [0.0; 2];
+    let mut n = 0usize;
+    for (s, u) in samples.iter().zip(torque) {
+        if s.time > t_end - window + 1e-9 {
+            for j in 0..2 {
+                sum[j] += u[j] * u[j];
+            }
+            n += 1;
+        }
+    }
+    sum.map(|v| (v / n.max(1) as f64).sqrt())
 }
 
 /// Runs one case, with or without adaptation (synchronous: the numbers do
@@ -543,7 +564,7 @@ pub fn run_case(setup: &Setup, case: &Case, seed: u64, adapt: bool) -> Result<Ou
     let (mean, _) = energy_tail(&run.samples, e_ref, SCORED_WINDOW);
     let friction = rms_friction_torque(&run.samples, &plant, SCORED_WINDOW);
     let energy_error = (mean - e_ref) / e_ref;
-    let rms_torque = [summary.rms_torque[0], summary.rms_torque[1]];
+    let rms_torque = rms_tail(&run.samples, &run.motor_torque, SCORED_WINDOW);
     let friction_torque = [friction[0], friction[1]];
     Ok(Outcome {
         success: succeeds(energy_error, rms_torque, friction_torque),
