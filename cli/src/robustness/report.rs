@@ -2,7 +2,7 @@
 //! one CSV row per run, and one plot panel per category (energy error
 //! against the varied quantity, success marked).
 
-use super::{CATEGORIES, Case, Outcome};
+use super::{CATEGORIES, Case, ENERGY_TOLERANCE, Outcome, TORQUE_ALLOWANCE};
 use crate::report::{PlotError, register_font};
 use plotters::prelude::*;
 use std::fmt::Write as _;
@@ -38,20 +38,24 @@ pub fn score(rows: &[RunPair], category: &str) -> (f64, f64, usize) {
 
 fn outcome_cells(o: &Outcome) -> String {
     format!(
-        "{} | {} | {:+.2} | {:.3} / {:.3} |",
+        "{} | {:+.2} | {:.3} / {:.3} | {:.3} / {:.3} |",
         if o.success { "yes" } else { "**no**" },
-        o.time_to_band.map_or("-".into(), |t| format!("{t:.1}")),
         100.0 * o.energy_error,
         o.rms_torque[0],
-        o.rms_torque[1]
+        o.rms_torque[1],
+        o.friction_torque[0] + TORQUE_ALLOWANCE,
+        o.friction_torque[1] + TORQUE_ALLOWANCE,
     )
 }
 
 /// The Markdown report: `title` (the configuration), the score table, and
 /// one table per category.
 pub fn markdown(title: &str, rows: &[RunPair]) -> String {
-    let mut s =
-        format!("{title}\n\n## Scores (share of runs that reach the 5 % band and stay)\n\n");
+    let mut s = format!(
+        "{title}\n\n## Scores (share of runs within {} % of E_ref with RMS torque at most friction + {} N m)\n\n",
+        100.0 * ENERGY_TOLERANCE,
+        TORQUE_ALLOWANCE
+    );
     s.push_str("| category | runs | without adaptation | with adaptation |\n|---|---|---|---|\n");
     let (mut all_off, mut all_on, mut all_n) = (0.0, 0.0, 0usize);
     for category in CATEGORIES {
@@ -74,9 +78,10 @@ pub fn markdown(title: &str, rows: &[RunPair]) -> String {
         .unwrap();
     }
     s.push_str(
-        "\nPer run: success, time the band was entered for good (s), energy error of the mean \
-         over the last 5 s (%), RMS applied torque over the last 5 s (N m), without | with \
-         adaptation.\n",
+        "\nPer run: success, energy error of the mean over the last 5 s (%), RMS motor torque \
+         over the last 5 s per joint (N m), the torque allowed (the plant's RMS friction torque \
+         along the last 5 s + 0.03 N m), without | with adaptation, and the models the \
+         adaptation swapped in.\n",
     );
     for category in CATEGORIES {
         let runs: Vec<&RunPair> = rows
@@ -92,7 +97,7 @@ pub fn markdown(title: &str, rows: &[RunPair]) -> String {
         };
         writeln!(
             s,
-            "| parameter | value{unit} | ok | band (s) | E error (%) | tau RMS (N m) | ok (adapt) | band (s) | E error (%) | tau RMS (N m) | models |"
+            "| parameter | value{unit} | ok | E error (%) | tau RMS (N m) | allowed (N m) | ok (adapt) | E error (%) | tau RMS (N m) | allowed (N m) | models |"
         )
         .unwrap();
         s.push_str("|---|---|---|---|---|---|---|---|---|---|---|\n");
@@ -115,23 +120,26 @@ pub fn markdown(title: &str, rows: &[RunPair]) -> String {
 /// One CSV row per run and adaptation setting.
 pub fn csv(rows: &[RunPair]) -> String {
     let mut s = String::from(
-        "category,parameter,value,unit,adapt,success,time_to_band_s,energy_error,rms_tau1_Nm,rms_tau2_Nm,failed_solves,model_updates\n",
+        "category,parameter,value,unit,adapt,ekf,success,time_to_5pct_band_s,energy_error,rms_tau1_Nm,rms_tau2_Nm,rms_friction1_Nm,rms_friction2_Nm,failed_solves,model_updates\n",
     );
     for r in rows {
         for (adapt, o) in [(false, &r.off), (true, &r.on)] {
             writeln!(
                 s,
-                "{},{},{},{},{},{},{},{},{},{},{},{}",
+                "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
                 r.case.category,
                 r.case.parameter,
                 r.case.value,
                 r.case.unit,
                 adapt,
+                o.ekf,
                 o.success,
                 o.time_to_band.map_or(String::new(), |t| t.to_string()),
                 o.energy_error,
                 o.rms_torque[0],
                 o.rms_torque[1],
+                o.friction_torque[0],
+                o.friction_torque[1],
                 o.failed_solves,
                 o.model_updates
             )
@@ -145,11 +153,14 @@ pub fn csv(rows: &[RunPair]) -> String {
 fn axis_label(parameter: &str, unit: &str) -> String {
     let parameter = match parameter {
         "sigma" => "noise \u{3c3}",
-        "a" => "responsiveness a (u += a (\u{3c4} - u) per sample)",
+        "a" => "torque response a (u += a (\u{3c4} - u) per sample)",
+        "delay" => "measurement delay",
+        "profile" => "random pulse profile",
         p => p,
     };
     match unit {
         "x nominal" => "factor of the nominal value".to_string(),
+        "profile" => "pulse profile number".to_string(),
         "" => parameter.to_string(),
         "kg m^2" => format!("{parameter} (kg m\u{b2})"),
         unit => format!("{parameter} ({unit})"),
@@ -159,7 +170,7 @@ fn axis_label(parameter: &str, unit: &str) -> String {
 /// Plots one panel per category: the energy error (%) of the mean over
 /// the last 5 s against the varied quantity, without (blue) and with
 /// (orange) adaptation, one line per parameter; a filled circle is a
-/// success, a cross a failure; the 5 % band is shaded. PNG, or SVG when
+/// success (energy and torque), a cross a failure; the 1 % band is shaded. PNG, or SVG when
 /// the name ends in `.svg`.
 pub fn plot(path: &Path, title: &str, rows: &[RunPair]) -> Result<(), PlotError> {
     register_font()?;
@@ -167,7 +178,7 @@ pub fn plot(path: &Path, title: &str, rows: &[RunPair]) -> Result<(), PlotError>
         .into_iter()
         .filter(|c| rows.iter().any(|r| r.case.category == *c))
         .collect();
-    let columns = categories.len().clamp(1, 5);
+    let columns = categories.len().clamp(1, 4);
     let lines = categories.len().div_ceil(columns).max(1);
     let size = (380 * columns as u32, 340 * lines as u32 + 60);
     if path
@@ -204,7 +215,7 @@ where
 {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| PlotError::new(format!("{e}"));
     root.fill(&WHITE).map_err(err)?;
-    let root = root.titled(title, ("sans-serif", 22)).map_err(err)?;
+    let root = root.titled(title, ("sans-serif", 18)).map_err(err)?;
     let panels = root.split_evenly(grid);
     let off_colour = RGBColor(31, 119, 180);
     let on_colour = RGBColor(255, 127, 14);
@@ -219,12 +230,12 @@ where
             (a.min(v), b.max(v))
         });
         let pad = ((hi - lo) * 0.08).max(1e-3 * hi.abs().max(1e-3));
-        // Errors beyond +-60 % are drawn at the edge (the table has them).
-        let clip = |e: f64| (100.0 * e).clamp(-60.0, 60.0);
+        // Errors beyond +-20 % are drawn at the edge (the table has them).
+        let clip = |e: f64| (100.0 * e).clamp(-20.0, 20.0);
         let errors = runs
             .iter()
             .flat_map(|r| [clip(r.off.energy_error), clip(r.on.energy_error)]);
-        let (elo, ehi) = errors.fold((-6.0f64, 6.0f64), |(a, b), v| (a.min(v), b.max(v)));
+        let (elo, ehi) = errors.fold((-2.0f64, 2.0f64), |(a, b), v| (a.min(v), b.max(v)));
         let xs = (lo - pad)..(hi + pad);
         let ys = (elo * 1.1)..(ehi * 1.1);
         let mut drawn: Vec<(f64, f64)> = vec![];
@@ -258,11 +269,14 @@ where
             .map_err(err)?;
         chart
             .draw_series(std::iter::once(Rectangle::new(
-                [(lo - pad, -5.0), (hi + pad, 5.0)],
+                [
+                    (lo - pad, -100.0 * ENERGY_TOLERANCE),
+                    (hi + pad, 100.0 * ENERGY_TOLERANCE),
+                ],
                 RGBColor(0, 160, 0).mix(0.12).filled(),
             )))
             .map_err(err)?
-            .label("5 % band")
+            .label(format!("{} % band", 100.0 * ENERGY_TOLERANCE))
             .legend(|(x, y)| {
                 Rectangle::new(
                     [(x, y - 5), (x + 14, y + 5)],
