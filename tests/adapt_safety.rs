@@ -114,7 +114,7 @@ fn measurement_noise_does_not_make_adaptation_chatter() {
 fn an_undeclared_delay_does_not_make_adaptation_chatter() {
     let on = harmless(
         14.0,
-        30.0,
+        60.0,
         Imperfections {
             delay_samples: 4,
             ..Imperfections::default()
