@@ -1,9 +1,11 @@
 //! The EigenMPC command line's library part: the paper-style reports of a
 //! closed loop (summary text, CSV, plots), shared by `eigenmpc simulate` and
-//! the FMU demo, the robustness sweep (`eigenmpc robustness`) and parameter
-//! sweeps (`eigenmpc sweep`). The core crate and the FMU libraries stay free of the CLI,
+//! the FMU demo, those of its online adaptation (`simulate --adapt`), the
+//! robustness sweep (`eigenmpc robustness`) and parameter sweeps
+//! (`eigenmpc sweep`). The core crate and the FMU libraries stay free of the CLI,
 //! plotting and progress-bar crates.
 
+pub mod adaptation;
 pub mod paper;
 pub mod report;
 pub mod robustness;

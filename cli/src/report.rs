@@ -105,21 +105,45 @@ pub fn write_csv<const N: usize, const NX: usize>(
     path: &Path,
     trace: &[Sample<N, NX>],
 ) -> std::io::Result<()> {
+    write_csv_with(path, trace, &[], |_| vec![])
+}
+
+/// [`write_csv`] with `extra` columns after its own: `extra_cells(i)`
+/// gives those of sample `i`. A header cell with a comma or a quote (the
+/// FMU's `estimate.A[1,2]`) is quoted as RFC 4180 says.
+pub fn write_csv_with<const N: usize, const NX: usize>(
+    path: &Path,
+    trace: &[Sample<N, NX>],
+    extra: &[String],
+    mut extra_cells: impl FnMut(usize) -> Vec<String>,
+) -> std::io::Result<()> {
     let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
     let names = |base: &'static str| (1..=N).map(move |j| format!("{base}{j}"));
+    let quote = |cell: &String| {
+        if cell.contains([',', '"']) {
+            format!("\"{}\"", cell.replace('"', "\"\""))
+        } else {
+            cell.clone()
+        }
+    };
     let header: Vec<String> = std::iter::once("time".to_string())
         .chain(names("q"))
         .chain(names("qd"))
         .chain(names("tau"))
         .chain(["energy".to_string(), "solve_ms".to_string()])
+        .chain(extra.iter().map(quote))
         .collect();
     writeln!(f, "{}", header.join(","))?;
-    for s in trace {
+    for (i, s) in trace.iter().enumerate() {
         write!(f, "{}", s.time)?;
         for v in s.state.iter().chain(s.tau.iter()) {
             write!(f, ",{v}")?;
         }
-        writeln!(f, ",{},{}", s.energy, s.solve_time * 1e3)?;
+        write!(f, ",{},{}", s.energy, s.solve_time * 1e3)?;
+        for cell in extra_cells(i) {
+            write!(f, ",{}", quote(&cell))?;
+        }
+        writeln!(f)?;
     }
     f.flush()
 }

@@ -50,7 +50,7 @@ pub fn run_with<S, P, const N: usize, const NX: usize>(
     plant: &P,
     z0: &SVector<f64, NX>,
     duration: f64,
-    on_sample: impl FnMut(usize, &Controller<S, N, NX>, &ControlOutput<N>),
+    mut on_sample: impl FnMut(usize, &Controller<S, N, NX>, &ControlOutput<N>),
 ) -> Result<Vec<Sample<N, NX>>, IntegrationError>
 where
     S: MechanicalSystem<N>,
@@ -62,7 +62,7 @@ where
         z0,
         duration,
         |_, _| {},
-        on_sample,
+        |i, c, _, out| on_sample(i, &*c, out),
         |_, z| *z,
     )
 }
@@ -82,7 +82,45 @@ where
     S: MechanicalSystem<N>,
     P: MechanicalSystem<N>,
 {
-    run_inner(controller, plant, z0, duration, tune, |_, _, _| {}, measure)
+    run_inner(
+        controller,
+        plant,
+        z0,
+        duration,
+        tune,
+        |_, _, _, _| {},
+        measure,
+    )
+}
+
+/// [`run_measured`], calling `after_step(t, controller, measured)` right
+/// after the controller's step at time `t` with the measurement it was
+/// given: the place to feed an online adaptation
+/// ([`crate::adapt::Adaptation::sample`]), whose new model then serves from
+/// the next sample on, as in a real loop.
+pub fn run_measured_with<S, P, const N: usize, const NX: usize>(
+    controller: &mut Controller<S, N, NX>,
+    plant: &P,
+    z0: &SVector<f64, NX>,
+    duration: f64,
+    tune: impl FnMut(f64, &mut Controller<S, N, NX>),
+    measure: impl FnMut(f64, &SVector<f64, NX>) -> SVector<f64, NX>,
+    mut after_step: impl FnMut(f64, &mut Controller<S, N, NX>, &SVector<f64, NX>),
+) -> Result<Vec<Sample<N, NX>>, IntegrationError>
+where
+    S: MechanicalSystem<N>,
+    P: MechanicalSystem<N>,
+{
+    let dt = controller.config().dt;
+    run_inner(
+        controller,
+        plant,
+        z0,
+        duration,
+        tune,
+        |i, c, measured, _| after_step(i as f64 * dt, c, measured),
+        measure,
+    )
 }
 
 /// [`run`], calling `tune(t, controller)` right before the controller's
@@ -105,7 +143,7 @@ where
         z0,
         duration,
         tune,
-        |_, _, _| {},
+        |_, _, _, _| {},
         |_, z| *z,
     )
 }
@@ -116,7 +154,7 @@ fn run_inner<S, P, const N: usize, const NX: usize>(
     z0: &SVector<f64, NX>,
     duration: f64,
     mut tune: impl FnMut(f64, &mut Controller<S, N, NX>),
-    mut on_sample: impl FnMut(usize, &Controller<S, N, NX>, &ControlOutput<N>),
+    mut on_sample: impl FnMut(usize, &mut Controller<S, N, NX>, &SVector<f64, NX>, &ControlOutput<N>),
     mut measure: impl FnMut(f64, &SVector<f64, NX>) -> SVector<f64, NX>,
 ) -> Result<Vec<Sample<N, NX>>, IntegrationError>
 where
@@ -135,8 +173,9 @@ where
         let t = i as f64 * dt;
         let z = *ode.state();
         tune(t, controller);
-        let out = controller.step(&measure(t, &z));
-        on_sample(i, controller, &out);
+        let measured = measure(t, &z);
+        let out = controller.step(&measured);
+        on_sample(i, controller, &measured, &out);
         trace.push(Sample {
             time: t,
             state: z,

@@ -1,22 +1,32 @@
 //! `eigenmpc simulate`: closed loop of the EigenMPC controller against the
 //! accurate plant integrator; prints the summary, writes CSV and plots.
 
-use super::ModelArgs;
+use super::{ModelArgs, Robot};
 use anyhow::{Context, bail};
 use clap::Args;
-use eigenmpc::mechanics::Vector;
+use eigenmpc::adapt::{AdaptOptions, Adaptation};
+use eigenmpc::identify::{BaseParameters, base_parameter_count};
+use eigenmpc::mechanics::{DoublePendulum, PlanarChainParams, Vector};
+use eigenmpc::model_file::RobotFile;
 use eigenmpc::modes::{Chart, ChartFamily, Family, FamilyOptions, linear_modes};
 use eigenmpc::mpc::closed_loop::{
-    GaussianNoise, Summary, energy_tail, mode_and_chart, rms_friction_torque, run_measured,
+    GaussianNoise, Summary, energy_tail, mode_and_chart, rms_friction_torque, run_measured_with,
     summarise,
 };
 use eigenmpc::mpc::{
     Controller, EstimatorConfig, MpcConfig, QpBackend, Reference, Variant,
     prediction_coulomb_sharpness, prediction_substeps,
 };
-use eigenmpc_cli::report::{PlotInfo, number, plot_run, summary_text, window_label, write_csv};
+use eigenmpc_cli::adaptation::{self, AdaptationSample, base_parameter_names};
+use eigenmpc_cli::report::{
+    PlotInfo, number, plot_run, summary_text, window_label, write_csv_with,
+};
 use nalgebra::SVector;
 use std::path::{Path, PathBuf};
+
+/// Base parameters of the 2-joint chain (inertia and gravity amplitudes,
+/// rotor inertias, viscous and Coulomb friction).
+const NP: usize = base_parameter_count(2);
 
 /// Arguments of `eigenmpc simulate`.
 #[derive(Args, Debug)]
@@ -131,8 +141,57 @@ pub struct SimulateArgs {
     /// at most 1 s and N dt).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     actuator_time_constant: f64,
+    /// Online adaptation of the controller's model, as the controller FMU's `adapt`: base
+    /// parameters identified from the energy balance, a new model (and mode family) taken from
+    /// a steady loop when it explains the motion better; adds the estimate, the model in use and
+    /// the counts to the CSV and the summary, and a figure FILE_adaptation next to --plot FILE.
+    #[arg(long)]
+    adapt: bool,
+    /// The plant: a robot parameter file (as --model, the same number of joints) that differs
+    /// from the controller's model; default: the plant is the model.
+    #[arg(long, value_name = "FILE")]
+    plant: Option<PathBuf>,
     #[command(flatten)]
     model: ModelArgs,
+}
+
+/// The robot for a caption: its file, or the point masses.
+fn robot_name(robot: &Robot) -> String {
+    match &robot.file {
+        Some(f) => f.path().display().to_string(),
+        None if *robot.system.params() == PlanarChainParams::default() => {
+            "the paper's pendulum".into()
+        }
+        None => {
+            let links = &robot.system.params().links;
+            format!(
+                "point masses {} / {} kg, l {} / {} m",
+                number(links[0].mass),
+                number(links[1].mass),
+                number(links[0].length),
+                number(links[1].length)
+            )
+        }
+    }
+}
+
+/// The plant of `--plant FILE`: a chain with the model's number of joints.
+fn plant_from_file(path: &Path, model: &Robot) -> anyhow::Result<Robot> {
+    let file = RobotFile::load(path).context("--plant")?;
+    let joints = model.file.as_ref().map_or(2, RobotFile::links);
+    if file.links() != joints {
+        bail!(
+            "--plant {}: the plant has {} joints, the controller's model ({}) has {joints}: \
+             give a plant with as many",
+            path.display(),
+            file.links(),
+            robot_name(model)
+        );
+    }
+    Ok(Robot {
+        system: file.chain::<2>().context("--plant")?,
+        file: Some(file),
+    })
 }
 
 /// Reads the chart of the mode closest to `energy` from `eigenmpc modes`
@@ -239,7 +298,16 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
             );
         }
     }
-    for (flag, path) in [("csv", &args.csv), ("plot", &args.plot)] {
+    let adapt_plot = args
+        .plot
+        .as_ref()
+        .filter(|_| args.adapt)
+        .map(|p| adaptation::figure_path(p));
+    for (flag, path) in [
+        ("csv", &args.csv),
+        ("plot", &args.plot),
+        ("plot", &adapt_plot),
+    ] {
         if let Some(path) = path {
             std::fs::File::create(path)
                 .with_context(|| format!("--{flag} {}: cannot write", path.display()))?;
@@ -250,20 +318,30 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
         None => vec![],
     };
     let robot = args.model.robot()?;
-    let plant = robot.system;
-    let limits = robot.file.as_ref().and_then(|f| f.torque_limits());
-    if let Some(tl) = limits.iter().flatten().find(|&&tl| args.tau_max > tl) {
-        bail!(
-            "--tau-max {} exceeds the robot's motor torque limit {tl} N m",
-            args.tau_max
-        );
+    // The controller's model (before its prediction's Coulomb slope) and
+    // the plant it drives: the same robot unless --plant says otherwise.
+    let system: DoublePendulum = robot.system;
+    let plant_robot = match &args.plant {
+        Some(path) => Some(plant_from_file(path, &robot)?),
+        None => None,
+    };
+    let plant = plant_robot.as_ref().map_or(system, |r| r.system);
+    for r in std::iter::once(&robot).chain(&plant_robot) {
+        let limits = r.file.as_ref().and_then(|f| f.torque_limits());
+        if let Some(tl) = limits.iter().flatten().find(|&&tl| args.tau_max > tl) {
+            bail!(
+                "--tau-max {} exceeds the motor torque limit {tl} N m of {}",
+                args.tau_max,
+                robot_name(r)
+            );
+        }
     }
     let mut config = MpcConfig::paper(variant);
     config.horizon = args.horizon;
     config.dt = args.dt;
     config.substeps = args
         .substeps
-        .unwrap_or_else(|| prediction_substeps(&plant, args.dt));
+        .unwrap_or_else(|| prediction_substeps(&system, args.dt));
     config.tau_max = args.tau_max;
     config.iterations_per_sample = args.iterations;
     config.qp = backend;
@@ -297,11 +375,19 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
     config.validate()?;
     let sharpness = match args.model_coulomb_sharpness {
         Some(k) => k,
-        None => prediction_coulomb_sharpness(&plant, config.dt / config.substeps as f64),
+        None => prediction_coulomb_sharpness(&system, config.dt / config.substeps as f64),
     };
-    let model = plant.with_coulomb_sharpness(sharpness)?;
+    let model = system.with_coulomb_sharpness(sharpness)?;
+    if args.adapt {
+        // Refused before the mode family is computed, not after.
+        BaseParameters::<2, NP>::of(model.params()).context("--adapt")?;
+    }
     let e_final = schedule.last().map_or(args.energy, |s| s.1);
-    let use_family = variant.uses_chart() && (args.chart_family || !schedule.is_empty());
+    // With --adapt a chart variant follows its model's mode family, as the
+    // FMU's default (chart_source = computed): each new model brings its
+    // own charts. A chart from --chart stays (as chart_source = parameters).
+    let use_family = variant.uses_chart()
+        && (args.chart_family || !schedule.is_empty() || (args.adapt && args.chart.is_none()));
     let mut controller = if use_family {
         if args.chart.is_some() {
             bail!("--chart and a chart family (--chart-family, --e-ref-at) exclude each other");
@@ -309,7 +395,7 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
         let asked: Vec<f64> = schedule.iter().map(|s| s.1).chain([args.energy]).collect();
         let defaults = match args.family_energy_max {
             Some(e) => FamilyOptions::up_to(e),
-            None => FamilyOptions::for_system(&plant, &asked),
+            None => FamilyOptions::for_system(&system, &asked),
         };
         let e_max = defaults.energy_max;
         let opts = FamilyOptions {
@@ -350,13 +436,29 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
     };
     let (mode, _) = mode_and_chart::<_, 2, 4>(&plant, family.index(), e_final, 9)
         .with_context(|| format!("{family} eigenmode of the plant at {e_final} J"))?;
+    let mut adaptation = if args.adapt {
+        let options = AdaptOptions {
+            // Wait for each new model: the same numbers on every machine.
+            synchronous: true,
+            family_energy_max: args.family_energy_max.unwrap_or(0.0),
+            ..AdaptOptions::default()
+        };
+        Some(
+            Adaptation::<2, 4, NP>::new(controller.system().params(), options)
+                .context("--adapt")?,
+        )
+    } else {
+        None
+    };
+    let mut adapted: Vec<AdaptationSample<NP>> = vec![];
     let z0 = SVector::<f64, 4>::from_column_slice(&x0);
     let mut next = 0;
     let mut noise = GaussianNoise::new(args.seed);
     // Before the first sample the plant rested at z0.
     let mut history: std::collections::VecDeque<SVector<f64, 4>> =
         std::iter::repeat_n(z0, args.delay_samples).collect();
-    let trace = run_measured(
+    let dt = config.dt;
+    let trace = run_measured_with(
         &mut controller,
         &plant,
         &z0,
@@ -377,9 +479,37 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
                 seen
             }
         },
+        |_, c, measured| {
+            let Some(a) = adaptation.as_mut() else {
+                return;
+            };
+            // As the FMU and the robustness runs feed it: the state the
+            // solve used (the EKF's estimate when it runs) and the torque
+            // that acted over the sample before the measurement.
+            let used = c.state_estimate().copied().unwrap_or(*measured);
+            let q = Vector::<2>::new(used[0], used[1]);
+            let qd = Vector::<2>::new(used[2], used[3]);
+            let felt = c.torque_before_measurement();
+            a.sample(c, &q, &qd, &felt, dt);
+            adapted.push(AdaptationSample {
+                estimate: a.identification().estimate().theta,
+                in_use: a.in_use().theta,
+                status: a.status(),
+                model_updates: a.model_updates(),
+                refusals: a.refusals(),
+                reverts: a.reverts(),
+            });
+        },
     )?;
     let summary = summarise(&trace, e_final, Some(&mode.path), 5.0);
-    print_summary(args, variant, family, &summary);
+    let setup = plant_robot.as_ref().map(|p| {
+        format!(
+            "plant {}, controller's model {}",
+            robot_name(p),
+            robot_name(&robot)
+        )
+    });
+    print_summary(args, variant, family, setup.as_deref(), &summary);
     let (mean, rms) = energy_tail(&trace, e_final, 5.0);
     let window = window_label(summary.window);
     println!(
@@ -400,13 +530,49 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
             t.norm() / f.norm()
         );
         println!(
-            "prediction model:               Coulomb slope k = {sharpness:.4} s/rad (plant {}), {} RK4 substeps",
-            plant.params().coulomb_sharpness,
+            "prediction model:               Coulomb slope k = {sharpness:.4} s/rad (model {}), {} RK4 substeps",
+            system.params().coulomb_sharpness,
             config.substeps
         );
     }
+    // The plant's base parameters (None with joint springs: its energy is
+    // not linear in them) and the model's before any adaptation.
+    let truth = BaseParameters::<2, NP>::of(plant.params())
+        .ok()
+        .map(|b| b.theta);
+    let names = base_parameter_names::<2>();
+    if args.adapt {
+        let start = BaseParameters::<2, NP>::of(system.params())
+            .context("--adapt")?
+            .theta;
+        print!(
+            "{}",
+            adaptation::summary_text::<2, NP>(
+                &names,
+                &adapted,
+                &start,
+                truth.as_ref(),
+                system.params().joints[0].gear_ratio
+            )
+        );
+        let gears = |p: &DoublePendulum| p.params().joints.map(|j| j.gear_ratio);
+        if gears(&plant) != gears(&system) {
+            println!(
+                "  (the plant's gear ratios differ from the model's, which the identification \
+                 takes as known: its rotor inertias Ir are not comparable)"
+            );
+        }
+    }
     if let Some(path) = &args.csv {
-        write_csv(path, &trace).with_context(|| format!("writing {}", path.display()))?;
+        let columns = if args.adapt {
+            adaptation::csv_columns(&names)
+        } else {
+            vec![]
+        };
+        write_csv_with(path, &trace, &columns, |i| {
+            adapted.get(i).map_or(vec![], adaptation::csv_cells)
+        })
+        .with_context(|| format!("writing {}", path.display()))?;
     }
     if let Some(path) = &args.plot {
         let info = PlotInfo {
@@ -423,10 +589,27 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
         plot_run(path, &trace, &mode.path, e_final, &info)
             .with_context(|| format!("plotting {}", path.display()))?;
     }
+    if let Some(path) = &adapt_plot {
+        let caption = format!(
+            "online adaptation, {variant} EigenMPC, E_ref = {} J: plant {}, model {}",
+            number(e_final),
+            robot_name(plant_robot.as_ref().unwrap_or(&robot)),
+            robot_name(&robot)
+        );
+        let times: Vec<f64> = trace.iter().map(|s| s.time).collect();
+        adaptation::plot_adaptation(path, &caption, &names, &times, &adapted, truth.as_ref())
+            .with_context(|| format!("plotting {}", path.display()))?;
+    }
     Ok(())
 }
 
-fn print_summary(args: &SimulateArgs, variant: Variant, family: Family, s: &Summary<2>) {
+fn print_summary(
+    args: &SimulateArgs,
+    variant: Variant,
+    family: Family,
+    setup: Option<&str>,
+    s: &Summary<2>,
+) {
     println!(
         "{variant} EigenMPC, {family}, E_ref = {} J, x0 = {}, {} s, N = {}, dt = {} s, QP {}",
         args.energy,
@@ -436,5 +619,8 @@ fn print_summary(args: &SimulateArgs, variant: Variant, family: Family, s: &Summ
         args.dt,
         args.qp.trim().to_ascii_lowercase()
     );
+    if let Some(setup) = setup {
+        println!("{setup}");
+    }
     print!("{}", summary_text(s));
 }
