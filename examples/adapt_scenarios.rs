@@ -111,6 +111,11 @@ fn rows() -> Vec<Row> {
             ..base("exact, noise 0.03, 10 J", paper(), 10.0)
         },
         Row {
+            imperfections: noise(0.03),
+            ekf: true,
+            ..base("exact, noise 0.03, EKF, 10 J", paper(), 10.0)
+        },
+        Row {
             imperfections: Imperfections {
                 delay_samples: 4,
                 ..Imperfections::default()
@@ -158,9 +163,11 @@ fn run(row: &Row, adapt: bool) -> String {
     config.tau_max = row.tau_max;
     config.substeps = prediction_substeps(&model, config.dt);
     if row.ekf {
+        // The EKF told the sensors' noise.
+        let noise = row.imperfections.measurement_noise.max(0.005);
         config.estimator = Some(EstimatorConfig {
-            angle_noise: 0.01,
-            speed_noise: 0.01,
+            angle_noise: noise,
+            speed_noise: noise,
             acceleration_noise: 1.0,
         });
     }
