@@ -65,6 +65,8 @@ fn rows() -> Vec<Row> {
     };
     let mut m2_light = paper();
     m2_light.links[1].mass *= 0.8;
+    let mut m1_light = paper();
+    m1_light.links[0].mass *= 0.75;
     let mut l1_short = paper();
     l1_short.links[0].length *= 0.92;
     l1_short.links[0].com *= 0.92;
@@ -123,6 +125,13 @@ fn rows() -> Vec<Row> {
             ..base("exact, delay 4", paper(), 14.0)
         },
         base("m2 -20 %", m2_light, 14.0),
+        base("m1 -25 %", m1_light, 14.0),
+        // The controller's own limit there: its degree-9 chart of this
+        // robot's mode at 14 J.
+        Row {
+            model: m1_light,
+            ..base("m1 -25 %, exact model", m1_light, 14.0)
+        },
         base("l1 -8 %, 10 J", l1_short, 10.0),
         Row {
             duration: 90.0,

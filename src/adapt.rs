@@ -586,7 +586,7 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
         let mut theta = BaseParameters::<N, NP> {
             theta: self.in_use + (estimate - self.in_use) * step,
         }
-        .projected()
+        .projected(&self.prior)
         .theta;
         // Free motion and friction give the ratios of the energy parameters;
         // only work that changes the energy gives their scale. While the

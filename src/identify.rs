@@ -136,9 +136,22 @@ impl<const N: usize, const NP: usize> BaseParameters<N, NP> {
     /// The nearest parameters whose rotor inertias and friction
     /// coefficients are not negative (an unconstrained estimate of a
     /// frictionless joint scatters around zero).
-    pub fn projected(&self) -> Self {
+    ///
+    /// The first joint's rotor turns at `gr_1 qd_1`, so its energy and the
+    /// link inertia amplitude `A_11` act only as `A_11 + gr_1^2 Ir_1`; the
+    /// least squares puts a change of that sum mostly into `Ir_1` (its
+    /// regressor is `gr_1^2` times larger). A negative `Ir_1` is therefore
+    /// moved into `A_11`, keeping the sum, not cut off (cut off, a link 1
+    /// 25 % lighter than the model was refused as not better).
+    pub fn projected(&self, prior: &PlanarChainParams<N>) -> Self {
         let mut theta = self.theta;
-        for v in theta.iter_mut().skip(Self::rotor_index(0)) {
+        let rotor = Self::rotor_index(0);
+        if theta[rotor] < 0.0 {
+            let gr = prior.joints[0].gear_ratio;
+            theta[Self::a_index(0, 0)] += gr * gr * theta[rotor];
+            theta[rotor] = 0.0;
+        }
+        for v in theta.iter_mut().skip(rotor) {
             *v = v.max(0.0);
         }
         Self { theta }

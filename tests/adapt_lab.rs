@@ -36,9 +36,12 @@ fn rough(robot: &PlanarChainParams<2>) -> PlanarChainParams<2> {
 
 /// 60 s at E_ref = 2 J, |tau| <= 0.5 N m: the energy error (relative), the
 /// RMS torque and the plant's friction torque over the last 5 s per joint.
-fn run(plant: PlanarChainParams<2>, adapt: bool) -> (f64, [f64; 2], [f64; 2]) {
+fn run(
+    plant: PlanarChainParams<2>,
+    prior: PlanarChainParams<2>,
+    adapt: bool,
+) -> (f64, [f64; 2], [f64; 2]) {
     let (e_ref, seconds) = (2.0, 60.0);
-    let prior = rough(&plant);
     let model = PlanarChain::new(prior).unwrap();
     let mut options = FamilyOptions::for_system(&model, &[e_ref]);
     options.degree = 9;
@@ -96,21 +99,36 @@ fn run(plant: PlanarChainParams<2>, adapt: bool) -> (f64, [f64; 2], [f64; 2]) {
 fn a_rough_model_of_the_lab_robots_is_corrected() {
     for file in ["lab-double-pendulum-A0.yml", "lab-double-pendulum-B0.yml"] {
         let plant = robot(file);
-        let (off, _, _) = run(plant, false);
-        let (error, torque, friction) = run(plant, true);
+        corrected(file, plant, rough(&plant));
+    }
+}
+
+#[test]
+fn a_lighter_link_1_than_the_model_is_found() {
+    // Link 1 25 % lighter than the robot file says. The first rotor's
+    // inertia and link 1's act only as one sum, which the estimate first
+    // puts into the rotor (negative); cut off at zero instead of moved
+    // into link 1, every candidate was refused (A0 ended 6.3 % low).
+    let nominal = robot("lab-double-pendulum-A0.yml");
+    let mut lighter = nominal;
+    lighter.links[0].mass *= 0.75;
+    corrected("A0, m1 x0.75", lighter, nominal);
+}
+
+/// Without adaptation the plant ends more than 3 % off; with it within 2 %
+/// at most 1.3 times the friction torque + 0.02 N m.
+fn corrected(what: &str, plant: PlanarChainParams<2>, model: PlanarChainParams<2>) {
+    let (off, _, _) = run(plant, model, false);
+    let (error, torque, friction) = run(plant, model, true);
+    assert!(off.abs() > 0.03, "{what}: the model alone is off by {off}");
+    assert!(error.abs() < 0.02, "{what}: energy error {error}");
+    for j in 0..2 {
         assert!(
-            off.abs() > 0.03,
-            "{file}: the rough model alone is off by {off}"
+            torque[j] <= 1.3 * friction[j] + 0.02,
+            "{what}: joint {}: torque {} vs friction {}",
+            j + 1,
+            torque[j],
+            friction[j]
         );
-        assert!(error.abs() < 0.02, "{file}: energy error {error}");
-        for j in 0..2 {
-            assert!(
-                torque[j] <= 1.3 * friction[j] + 0.02,
-                "{file}: joint {}: torque {} vs friction {}",
-                j + 1,
-                torque[j],
-                friction[j]
-            );
-        }
     }
 }

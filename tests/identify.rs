@@ -192,8 +192,13 @@ fn recursive_least_squares_recovers_a_plant_the_prior_gets_wrong() {
         assert!((estimate[i] - 0.05).abs() < 0.01, "b: {}", estimate[i]);
     }
     // the mapped chain has the plant's energy along other states
-    let mapped =
-        PlanarChain::new(rls.estimate().projected().chain_params(&prior).unwrap()).unwrap();
+    let mapped = PlanarChain::new(
+        rls.estimate()
+            .projected(&prior)
+            .chain_params(&prior)
+            .unwrap(),
+    )
+    .unwrap();
     let true_chain = PlanarChain::new(plant).unwrap();
     for (q, qd) in states::<2>() {
         let (a, b) = (mapped.energy(&q, &qd), true_chain.energy(&q, &qd));
@@ -349,5 +354,32 @@ fn the_window_variance_is_calibrated_under_sensor_noise() {
             rls.scale_uncertainty()
         );
         assert!((0.5..2.0).contains(&mean), "noise {noise}: {mean}");
+    }
+}
+
+#[test]
+fn a_negative_first_rotor_inertia_is_moved_into_the_link_inertia() {
+    // A_11 and Ir_1 act only as A_11 + gr_1^2 Ir_1: the projection keeps
+    // that sum (the dynamics) instead of cutting Ir_1 off at zero.
+    let prior = robot_a0();
+    let gr = prior.joints[0].gear_ratio;
+    let mut theta = BaseParameters::<2, 11>::of(&prior).unwrap().theta;
+    let sum = theta[0] + gr * gr * theta[5];
+    theta[5] = -2e-4;
+    theta[0] = sum - gr * gr * theta[5];
+    let projected = BaseParameters::<2, 11> { theta }.projected(&prior).theta;
+    assert_eq!(projected[5], 0.0);
+    assert!((projected[0] + gr * gr * projected[5] - sum).abs() < 1e-12);
+    // The same chain energy along any state.
+    let a = PlanarChain::new(
+        BaseParameters::<2, 11> { theta: projected }
+            .chain_params(&prior)
+            .unwrap(),
+    )
+    .unwrap();
+    let b = PlanarChain::new(prior).unwrap();
+    for (q, qd) in states::<2>() {
+        let (ea, eb) = (a.energy(&q, &qd), b.energy(&q, &qd));
+        assert!((ea - eb).abs() < 1e-9 * eb.abs().max(1.0), "{ea} vs {eb}");
     }
 }

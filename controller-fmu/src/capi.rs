@@ -291,8 +291,12 @@ fn in_config_terms(message: String, fields: &[(&str, &str, f64)]) -> String {
 /// Checks a tunable as the controller FMU of `joints` joints does.
 fn check_tunable(joints: usize, name: &str, v: f64) -> Result<(), String> {
     match joints {
+        2 => check_named::<EigenMpc2, 2>(name, v),
         3 => check_named::<EigenMpc3, 3>(name, v),
-        _ => check_named::<EigenMpc2, 2>(name, v),
+        // Never a default: a handle of another joint count is a bug.
+        n => Err(format!(
+            "{name}: no {n}-joint controller to check it against"
+        )),
     }
 }
 
