@@ -54,7 +54,7 @@ fn rows() -> Vec<Row> {
         plant,
         e_ref,
         tau_max: 1.0,
-        duration: 30.0,
+        duration: 60.0,
         imperfections: Imperfections::default(),
         ekf: false,
         z0: [0.05, 0.05, 0.0, 0.0],
@@ -133,6 +133,16 @@ fn rows() -> Vec<Row> {
             ..base("m1 -25 %, exact model", m1_light, 14.0)
         },
         base("l1 -8 %, 10 J", l1_short, 10.0),
+        {
+            let mut p = paper();
+            p.links[0].mass *= 0.975;
+            base("m1 -2.5 %", p, 14.0)
+        },
+        {
+            let mut p = paper();
+            p.links[0].mass *= 1.025;
+            base("m1 +2.5 %", p, 14.0)
+        },
         Row {
             duration: 90.0,
             ..base("m2 +25 %, l1 -8 %, b 0.03, 10 J", combined, 10.0)

@@ -72,7 +72,7 @@ impl Default for AdaptOptions {
     fn default() -> Self {
         Self {
             period: 40,
-            min_change: 1e-2,
+            min_change: 2e-3,
             trust_region: 0.3,
             max_scale_uncertainty: 0.02,
             min_validation_windows: 6,
@@ -538,7 +538,10 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
     /// the trust region, physical, not the model just reverted; posts its
     /// model to the worker.
     fn propose(&mut self, controller: &Controller<PlanarChain<N>, N, NX>) {
-        let estimate = self.rls.estimate().theta;
+        // The change is measured on the estimate as a model would take it
+        // (rotor inertias and friction not negative): a frictionless joint's
+        // estimate scattering below zero is no change.
+        let estimate = self.rls.estimate().projected(&self.prior).theta;
         let floor = self.options.rls.prior_floor;
         let relative = |a: &SVector<f64, NP>, b: &SVector<f64, NP>| {
             (0..NP)
