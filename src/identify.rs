@@ -484,6 +484,10 @@ impl NoiseEstimate {
     }
 }
 
+/// Standard deviations of a window's predicted error beyond which it is
+/// down-weighted (Huber's k).
+const HUBER: f64 = 3.0;
+
 /// Energy-balance identification by least squares, fed one sample at a
 /// time (the state `q`, `qd` and the torque applied over the previous
 /// sample); fixed size, no allocation (an `NP x NP` Cholesky per window).
@@ -797,10 +801,25 @@ impl<const N: usize, const NP: usize> EnergyBalanceRls<N, NP> {
             self.skipped += 1;
             return false;
         }
-        self.normal = self.normal * lambda + h * h.transpose();
-        self.rhs = self.rhs * lambda + h * y;
-        self.sum_y2 = self.sum_y2 * lambda + y * y;
-        self.count = self.count * lambda + 1.0;
+        // A window the estimate cannot explain by 3 standard deviations of
+        // its prediction (an external push, a knock: not the robot) gets
+        // Huber's weight, once the variance is the windows' own; before,
+        // the prediction's spread is the prior's and nothing is an outlier.
+        let weight = if self.count >= self.options.residual_windows as f64 {
+            let spread = (variance + h.dot(&(self.covariance * h))).sqrt();
+            let error = (y - h.dot(&self.estimate)).abs();
+            if error > HUBER * spread {
+                HUBER * spread / error
+            } else {
+                1.0
+            }
+        } else {
+            1.0
+        };
+        self.normal = self.normal * lambda + h * h.transpose() * weight;
+        self.rhs = self.rhs * lambda + h * (y * weight);
+        self.sum_y2 = self.sum_y2 * lambda + y * y * weight;
+        self.count = self.count * lambda + weight;
         // The variance and the estimate depend on each other: a few fixed-
         // point steps from the last variance (the prior's pull is small
         // against the windows', so they settle at once).
