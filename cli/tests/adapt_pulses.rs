@@ -11,7 +11,7 @@ use eigenmpc_cli::robustness::{Case, Perturbation, Setup, run_case};
 
 #[test]
 fn torque_pulses_do_not_teach_the_model() {
-    let mut setup = Setup::new(&PlanarChainParams::<2>::default(), 14.0, 1.0, 60.0).unwrap();
+    let setup = Setup::new(&PlanarChainParams::<2>::default(), 14.0, 1.0, 60.0).unwrap();
     for profile in [15, 46] {
         let case = Case {
             category: "torque pulses",
