@@ -6,6 +6,8 @@
 //! before the identification weighted its windows by their fit's residual,
 //! the energy scale of A0 stayed 9 % uncertain and A0 ended 6.5 % high.
 
+#[path = "common/rough.rs"]
+mod rough_model;
 use eigenmpc::adapt::{AdaptOptions, Adaptation};
 use eigenmpc::mechanics::{PlanarChain, PlanarChainParams};
 use eigenmpc::model_file::RobotFile;
@@ -14,24 +16,11 @@ use eigenmpc::mpc::closed_loop::{energy_tail, rms_friction_torque};
 use eigenmpc::mpc::{Controller, MpcConfig, Variant, prediction_substeps};
 use eigenmpc::robustness::{Imperfections, run_imperfect};
 use nalgebra::SVector;
+use rough_model::rough;
 
 fn robot(file: &str) -> PlanarChainParams<2> {
     let path = format!("{}/robots/{file}", env!("CARGO_MANIFEST_DIR"));
     RobotFile::load(path).unwrap().params::<2>().unwrap()
-}
-
-/// Masses, centres of mass and inertias 10-20 % off, no friction.
-fn rough(robot: &PlanarChainParams<2>) -> PlanarChainParams<2> {
-    let mut p = *robot;
-    let f = [[1.15, 0.88, 1.2], [0.85, 1.12, 0.9]];
-    for ((link, joint), f) in p.links.iter_mut().zip(&mut p.joints).zip(f) {
-        link.mass *= f[0];
-        link.com *= f[1];
-        link.inertia *= f[2];
-        joint.viscous = 0.0;
-        joint.coulomb = 0.0;
-    }
-    p
 }
 
 /// 60 s at E_ref = 2 J, |tau| <= 0.5 N m: the energy error (relative), the

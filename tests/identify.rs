@@ -3,6 +3,8 @@
 //! maps back to a chain with the same dynamics, and recursive least squares
 //! recovers a plant the prior model gets wrong.
 
+#[path = "common/rough.rs"]
+mod rough_model;
 use eigenmpc::identify::{
     BaseParameters, EnergyBalanceRls, IdentifyError, RlsOptions, WindowEquation, energy_features,
     friction_features,
@@ -14,6 +16,7 @@ use eigenmpc::mechanics::{
 use eigenmpc::model_file::RobotFile;
 use eigenmpc::mpc::closed_loop::GaussianNoise;
 use nalgebra::SVector;
+use rough_model::rough;
 
 fn robot_a0() -> PlanarChainParams<2> {
     let path = concat!(
@@ -226,21 +229,6 @@ fn no_excitation_no_update() {
         rls.add_sample(&q, &Vector::<2>::zeros(), &Vector::<2>::zeros(), 0.025);
     }
     assert_eq!(rls.updates(), 0);
-}
-
-/// A rough model of a laboratory robot: masses, centres of mass and
-/// inertias 10-20 % off, no friction (as a user's CAD model).
-fn rough(robot: &PlanarChainParams<2>) -> PlanarChainParams<2> {
-    let mut p = *robot;
-    let f = [[1.15, 0.88, 1.2], [0.85, 1.12, 0.9]];
-    for ((link, joint), f) in p.links.iter_mut().zip(&mut p.joints).zip(f) {
-        link.mass *= f[0];
-        link.com *= f[1];
-        link.inertia *= f[2];
-        joint.viscous = 0.0;
-        joint.coulomb = 0.0;
-    }
-    p
 }
 
 /// The lab robot A0 under a torque held per sample, measured with
