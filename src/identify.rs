@@ -309,7 +309,7 @@ pub fn friction_features<const N: usize, const NP: usize>(
     f
 }
 
-/// Settings of the recursive least squares.
+/// Settings of the energy-balance least squares.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct RlsOptions {
     /// Forgetting factor per window, in (0, 1] (1: no forgetting).
@@ -501,8 +501,7 @@ const HUBER: f64 = 3.0;
 /// estimate made the noise look like. The estimate is the unconstrained
 /// least-squares one; a model is made of it only through
 /// [`BaseParameters::physical`]. (The name is kept from the recursive
-/// form this replaced; the estimate of a window is the same for a fixed
-/// variance.)
+/// form this replaced.)
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct EnergyBalanceRls<const N: usize, const NP: usize> {
     prior: PlanarChainParams<N>,
