@@ -8,6 +8,8 @@
 //!   tau_f(qd) = tau`, planar chains of rigid links with geared motors and
 //!   friction (the paper's double pendulum is the point-mass 2-link chain),
 //!   energy and exact derivatives;
+//! - [`joints`]: the joint counts compiled to fixed sizes (one table) and
+//!   [`with_joint_count!`], the dispatch from a count known at run time;
 //! - [`model_file`]: robots from JSON/YAML parameter files;
 //! - [`integrate`]: RK4 with sensitivities and adaptive Dormand-Prince 5(4);
 //! - [`modes`]: linear modes, nonlinear eigenmodes (brake orbits) continued in
@@ -21,6 +23,7 @@
 pub mod adapt;
 pub mod identify;
 pub mod integrate;
+pub mod joints;
 pub mod mechanics;
 pub mod model_file;
 pub mod modes;

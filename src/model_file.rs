@@ -29,8 +29,9 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
-/// Most links a parameter file may describe.
-pub const MAX_LINKS: usize = 3;
+/// Most links a parameter file may describe: the joint-count table's
+/// largest ([`crate::joints::MAX_JOINTS`]).
+pub const MAX_LINKS: usize = crate::joints::MAX_JOINTS;
 
 /// A parameter file that could not be used: the file and what is wrong.
 #[derive(Debug, Error, Clone, PartialEq)]

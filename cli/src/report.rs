@@ -211,10 +211,10 @@ pub fn plot_run<const N: usize, const NX: usize>(
     e_ref: f64,
     info: &PlotInfo,
 ) -> Result<(), PlotError> {
-    const { assert!(N >= 2, "the joint-space panel needs two joints") };
     // The font ships with the binary: no system fontconfig needed.
     register_font()?;
-    let size = (520 * (N as u32 + 1), 960);
+    let (rows, cols) = panel_grid(N);
+    let size = (520 * cols as u32, 480 * rows as u32);
     let svg = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("svg"));
@@ -235,6 +235,15 @@ pub fn plot_run<const N: usize, const NX: usize>(
             info,
         )
     }
+}
+
+/// Rows and columns of a run's panels (path, energy, every angle, every
+/// torque): two rows of `N + 1` up to 3 joints, then rows of 4 (small
+/// multiples that stay readable for 6 joints).
+fn panel_grid(joints: usize) -> (usize, usize) {
+    let panels = 2 * joints + 2;
+    let cols = (joints + 1).min(4);
+    (panels.div_ceil(cols), cols)
 }
 
 /// Colour of time `f` in [0, 1] along the path: light blue at the start,
@@ -263,11 +272,16 @@ where
         root.titled(&info.caption, ("sans-serif", 22))
             .map_err(err)?
     };
-    let panels = root.split_evenly((2, N + 1));
+    let panels = root.split_evenly(panel_grid(N));
     let t_start = trace.first().map_or(0.0, |s| s.time);
     let t_end = trace.last().map_or(1.0, |s| s.time).max(t_start + 1e-9);
     let (blue, red, grey) = (BLUE_DARK, RED, GREY);
-    draw_path_panel(&panels[0], trace, mode, "joint-space path")?;
+    let path_title = if N >= 2 {
+        "joint-space path"
+    } else {
+        "phase plane"
+    };
+    draw_path_panel(&panels[0], trace, mode, path_title)?;
 
     let band = 0.05 * e_ref.abs();
     let reached = crate::report::band_entry(trace, e_ref);
@@ -475,7 +489,9 @@ pub fn legend_line(style: ShapeStyle) -> impl Fn((i32, i32)) -> PathElement<(i32
 
 /// Joint-space panel of a run: the true eigenmode `mode` underneath as a
 /// broad light band, the closed loop on top coloured by time (the last 5 s
-/// bold), so that the final orbit can be compared with the mode.
+/// bold), so that the final orbit can be compared with the mode. The axes
+/// are the first two angles; a single joint is shown in its phase plane
+/// (angle, speed), the mode as its swing on the angle axis.
 pub fn draw_path_panel<DB: DrawingBackend, const N: usize, const NX: usize>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
     trace: &[Sample<N, NX>],
@@ -488,6 +504,9 @@ where
     let t_start = trace.first().map_or(0.0, |s| s.time);
     let t_end = trace.last().map_or(1.0, |s| s.time).max(t_start + 1e-9);
     let tail_start = t_end - 5.0;
+    // The vertical axis: angle 2, or joint 1's speed (state N = 1).
+    let y_index = if N >= 2 { 1 } else { N };
+    let mode_y = |q: &Vector<N>| if N >= 2 { q[1] } else { 0.0 };
     let xs = padded_range(
         trace
             .iter()
@@ -497,18 +516,26 @@ where
     let ys = padded_range(
         trace
             .iter()
-            .map(|s| s.state[1])
-            .chain(mode.iter().map(|q| q[1])),
+            .map(|s| s.state[y_index])
+            .chain(mode.iter().map(mode_y)),
     );
     let mut chart = panel_chart(area, caption, xs, ys)?;
+    let y_label = if N >= 2 {
+        format!("\u{3b8}{} (rad)", subscript(1))
+    } else {
+        format!("d\u{3b8}{}/dt (rad/s)", subscript(0))
+    };
     draw_mesh(
         &mut chart,
         &format!("\u{3b8}{} (rad)", subscript(0)),
-        &format!("\u{3b8}{} (rad)", subscript(1)),
+        &y_label,
     )?;
     let band = RED.mix(0.3).stroke_width(7);
     chart
-        .draw_series(LineSeries::new(mode.iter().map(|q| (q[0], q[1])), band))
+        .draw_series(LineSeries::new(
+            mode.iter().map(|q| (q[0], mode_y(q))),
+            band,
+        ))
         .map_err(plot_error)?
         .label("plant's eigenmode at E_ref")
         .legend(legend_line(band));
@@ -519,8 +546,8 @@ where
             let width = if w[1].time > tail_start { 2 } else { 1 };
             PathElement::new(
                 [
-                    (w[0].state[0], w[0].state[1]),
-                    (w[1].state[0], w[1].state[1]),
+                    (w[0].state[0], w[0].state[y_index]),
+                    (w[1].state[0], w[1].state[y_index]),
                 ],
                 time_colour(f).stroke_width(width),
             )

@@ -258,9 +258,9 @@ fn a_bad_parameter_file_gives_a_one_line_error_naming_key_and_file() {
             "key 'b2'",
         ),
         (
-            "three.json",
-            r#"{"m1":1,"m2":1,"m3":1,"l1":1,"l2":1,"l3":1,"g":9.81}"#,
-            "3-link",
+            "seven.json",
+            r#"{"m1":1,"m2":1,"m3":1,"m4":1,"m5":1,"m6":1,"m7":1,"l1":1,"l2":1,"l3":1,"l4":1,"l5":1,"l6":1,"l7":1,"g":9.81}"#,
+            "at most 6 links",
         ),
     ] {
         let path = dir.join(name);

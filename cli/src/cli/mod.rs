@@ -8,7 +8,7 @@ mod simulate;
 mod sweep;
 
 use clap::{Args, Parser, Subcommand};
-use eigenmpc::mechanics::{DoublePendulum, PlanarChainParams};
+use eigenmpc::mechanics::{PlanarChain, PlanarChainParams};
 use eigenmpc::model_file::RobotFile;
 use eigenmpc_fmu_models::controller::named::check_named;
 use eigenmpc_fmu_models::products::EigenMpc2;
@@ -91,25 +91,46 @@ pub struct ModelArgs {
 }
 
 /// The robot a command works on.
-pub struct Robot {
+pub struct Robot<const N: usize = 2> {
     /// The model (plant and, unless told otherwise, controller).
-    pub system: DoublePendulum,
+    pub system: PlanarChain<N>,
     /// The parameter file it came from, if any.
     pub file: Option<RobotFile>,
 }
 
 impl ModelArgs {
-    /// Builds the robot, refusing non-physical parameters and bad files.
-    pub fn robot(&self) -> anyhow::Result<Robot> {
+    /// The robot's joint count: the parameter file's links, or 2 for the
+    /// point-mass pendulum of `--m1 .. --g`. A count outside the joint-count
+    /// table is an error.
+    pub fn joint_count(&self) -> anyhow::Result<usize> {
+        match &self.model {
+            Some(path) => Ok(RobotFile::load(path)?.links()),
+            None => Ok(2),
+        }
+    }
+
+    /// Builds the 2-joint robot (the commands that are the paper's own).
+    pub fn robot(&self) -> anyhow::Result<Robot<2>> {
+        self.robot_of()
+    }
+
+    /// Builds the `N`-joint robot, refusing non-physical parameters, bad
+    /// files and a file of another joint count.
+    pub fn robot_of<const N: usize>(&self) -> anyhow::Result<Robot<N>> {
         Ok(match &self.model {
             Some(path) => {
                 let file = RobotFile::load(path)?;
                 Robot {
-                    system: file.chain::<2>()?,
+                    system: file.chain::<N>()?,
                     file: Some(file),
                 }
             }
             None => {
+                if N != 2 {
+                    anyhow::bail!(
+                        "--m1 .. --g describe the 2-joint pendulum: give a {N}-joint robot with --model FILE"
+                    );
+                }
                 // The controller FMU's ranges for the same parameters: one
                 // set of limits for every entry point (m in [1e-6, 1e6] kg,
                 // l in [1e-3, 1e3] m, g in [0, 1e3] m/s^2).
@@ -123,10 +144,11 @@ impl ModelArgs {
                     check_named::<EigenMpc2, 2>(name, value)
                         .map_err(|e| anyhow::anyhow!("{flag}: {e}"))?;
                 }
+                let (mass, length) = ([self.m1, self.m2], [self.l1, self.l2]);
                 Robot {
-                    system: DoublePendulum::new(PlanarChainParams::point_masses(
-                        [self.m1, self.m2],
-                        [self.l1, self.l2],
+                    system: PlanarChain::new(PlanarChainParams::point_masses(
+                        std::array::from_fn(|j| mass[j]),
+                        std::array::from_fn(|j| length[j]),
                         self.g,
                     ))?,
                     file: None,
@@ -136,19 +158,21 @@ impl ModelArgs {
     }
 }
 
-impl Robot {
+impl<const N: usize> Robot<N> {
     /// The `model` object of the JSON outputs: the paper's keys for the
     /// point-mass pendulum, the file and its entries for a parameter file.
     pub fn json(&self) -> serde_json::Value {
         match &self.file {
             None => {
                 let p = self.system.params();
-                serde_json::json!({
-                    "kind": "double-pendulum",
-                    "m1": p.links[0].mass, "m2": p.links[1].mass,
-                    "l1": p.links[0].length, "l2": p.links[1].length,
-                    "g": p.gravity,
-                })
+                let mut map = serde_json::Map::new();
+                map.insert("kind".into(), "double-pendulum".into());
+                for (j, link) in p.links.iter().enumerate() {
+                    map.insert(format!("m{}", j + 1), link.mass.into());
+                    map.insert(format!("l{}", j + 1), link.length.into());
+                }
+                map.insert("g".into(), p.gravity.into());
+                serde_json::Value::Object(map)
             }
             Some(f) => {
                 let mut map = serde_json::Map::new();

@@ -41,16 +41,16 @@ pub struct ModesArgs {
 
 /// Start values of the controller FMU for one eigenmode and its chart,
 /// generated from the FMU's own variable table (names, ranges, defaults).
-fn fmu_start_values(
-    robot: &Robot,
-    eigenvector: &Vector<2>,
+fn fmu_start_values<const N: usize>(
+    robot: &Robot<N>,
+    eigenvector: &Vector<N>,
     energy: f64,
-    chart: &Chart<2>,
+    chart: &Chart<N>,
 ) -> anyhow::Result<serde_json::Map<String, serde_json::Value>> {
-    let values = start_values::<2>(
+    let values = start_values::<N>(
         robot.system.params(),
         energy,
-        &[eigenvector[0], eigenvector[1]],
+        &std::array::from_fn(|j| eigenvector[j]),
         &chart.coefficients,
     )
     .map_err(|e| anyhow::anyhow!("--fmu-start-values: {e}"))?;
@@ -105,12 +105,22 @@ struct ModesJson {
     modes: Vec<ModeJson>,
 }
 
-fn vec2(v: &Vector<2>) -> Vec<f64> {
+fn vec2<const N: usize>(v: &Vector<N>) -> Vec<f64> {
     v.as_slice().to_vec()
 }
 
-/// Runs the subcommand: prints the JSON document on stdout.
+/// Runs the subcommand for the robot's joint count: prints the JSON
+/// document on stdout.
 pub fn run(args: &ModesArgs) -> anyhow::Result<()> {
+    let n = args.model.joint_count()?;
+    eigenmpc::with_joint_count!(
+        n,
+        |N, S, NP| run_for::<N, S>(args),
+        otherwise Err(anyhow::anyhow!(eigenmpc::joints::unsupported(n)))
+    )
+}
+
+fn run_for<const N: usize, const S: usize>(args: &ModesArgs) -> anyhow::Result<()> {
     let family: Family = args.family.parse().map_err(anyhow::Error::msg)?;
     let energies = parse_list("energies", &args.energies)?;
     if args.fmu_start_values.is_some() && energies.len() != 1 {
@@ -124,7 +134,7 @@ pub fn run(args: &ModesArgs) -> anyhow::Result<()> {
             2 * (args.degree + 1)
         );
     }
-    let robot = args.model.robot()?;
+    let robot = args.model.robot_of::<N>()?;
     let system = robot.system;
     let linear = linear_modes(&system)?[family.index()];
     let opts = ContinuationOptions {
@@ -138,7 +148,7 @@ pub fn run(args: &ModesArgs) -> anyhow::Result<()> {
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     bar.set_message(format!("{family} eigenmodes"));
-    let orbits = eigenmode_family_with_progress::<_, 2, 4>(
+    let orbits = eigenmode_family_with_progress::<_, N, S>(
         &system,
         family.index(),
         &energies,

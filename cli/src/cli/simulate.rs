@@ -5,8 +5,8 @@ use super::{ModelArgs, Robot};
 use anyhow::{Context, bail};
 use clap::Args;
 use eigenmpc::adapt::{AdaptOptions, Adaptation};
-use eigenmpc::identify::{BaseParameters, base_parameter_count};
-use eigenmpc::mechanics::{DoublePendulum, PlanarChainParams, Vector};
+use eigenmpc::identify::BaseParameters;
+use eigenmpc::mechanics::{PlanarChain, PlanarChainParams, Vector};
 use eigenmpc::model_file::RobotFile;
 use eigenmpc::modes::{Chart, ChartFamily, Family, FamilyOptions, linear_modes};
 use eigenmpc::mpc::closed_loop::{
@@ -24,10 +24,6 @@ use eigenmpc_cli::report::{
 use nalgebra::SVector;
 use std::path::{Path, PathBuf};
 
-/// Base parameters of the 2-joint chain (inertia and gravity amplitudes,
-/// rotor inertias, viscous and Coulomb friction).
-const NP: usize = base_parameter_count(2);
-
 /// Arguments of `eigenmpc simulate`.
 #[derive(Args, Debug)]
 pub struct SimulateArgs {
@@ -40,9 +36,10 @@ pub struct SimulateArgs {
     /// Reference energy E_ref (J).
     #[arg(long, default_value_t = 14.0, allow_negative_numbers = true)]
     energy: f64,
-    /// Initial state q1,q2,qd1,qd2 (rad, rad/s).
-    #[arg(long, default_value = "0.05,0.05,0,0", allow_hyphen_values = true)]
-    x0: String,
+    /// Initial state q1,..,qN,qd1,..,qdN (rad, rad/s); default: 0.05 rad on every joint, at
+    /// rest.
+    #[arg(long, allow_hyphen_values = true)]
+    x0: Option<String>,
     /// Simulated time (s).
     #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
     duration: f64,
@@ -156,7 +153,7 @@ pub struct SimulateArgs {
 }
 
 /// The robot for a caption: its file, or the point masses.
-fn robot_name(robot: &Robot) -> String {
+fn robot_name<const N: usize>(robot: &Robot<N>) -> String {
     match &robot.file {
         Some(f) => f.path().display().to_string(),
         None if *robot.system.params() == PlanarChainParams::default() => {
@@ -164,21 +161,26 @@ fn robot_name(robot: &Robot) -> String {
         }
         None => {
             let links = &robot.system.params().links;
+            let list = |f: fn(&eigenmpc::mechanics::Link) -> f64| {
+                links
+                    .iter()
+                    .map(|l| number(f(l)))
+                    .collect::<Vec<_>>()
+                    .join(" / ")
+            };
             format!(
-                "point masses {} / {} kg, l {} / {} m",
-                number(links[0].mass),
-                number(links[1].mass),
-                number(links[0].length),
-                number(links[1].length)
+                "point masses {} kg, l {} m",
+                list(|l| l.mass),
+                list(|l| l.length)
             )
         }
     }
 }
 
 /// The plant of `--plant FILE`: a chain with the model's number of joints.
-fn plant_from_file(path: &Path, model: &Robot) -> anyhow::Result<Robot> {
+fn plant_from_file<const N: usize>(path: &Path, model: &Robot<N>) -> anyhow::Result<Robot<N>> {
     let file = RobotFile::load(path).context("--plant")?;
-    let joints = model.file.as_ref().map_or(2, RobotFile::links);
+    let joints = N;
     if file.links() != joints {
         bail!(
             "--plant {}: the plant has {} joints, the controller's model ({}) has {joints}: \
@@ -189,25 +191,29 @@ fn plant_from_file(path: &Path, model: &Robot) -> anyhow::Result<Robot> {
         );
     }
     Ok(Robot {
-        system: file.chain::<2>().context("--plant")?,
+        system: file.chain::<N>().context("--plant")?,
         file: Some(file),
     })
 }
 
 /// Reads the chart of the mode closest to `energy` from `eigenmpc modes`
 /// JSON; the file's modes must be of `family`.
-fn chart_from_json(path: &Path, energy: f64, family: Family) -> anyhow::Result<Chart<2>> {
+fn chart_from_json<const N: usize>(
+    path: &Path,
+    energy: f64,
+    family: Family,
+) -> anyhow::Result<Chart<N>> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
     let doc: serde_json::Value =
         serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))?;
-    let vec2 = |v: &serde_json::Value, what: &str| -> anyhow::Result<Vector<2>> {
+    let vec2 = |v: &serde_json::Value, what: &str| -> anyhow::Result<Vector<N>> {
         let a: Vec<f64> = serde_json::from_value(v.clone())
             .with_context(|| format!("{what} must be a list of numbers"))?;
-        if a.len() != 2 {
-            bail!("{what} must have 2 entries");
+        if a.len() != N {
+            bail!("{what} must have {N} entries (one per joint)");
         }
-        Ok(Vector::<2>::new(a[0], a[1]))
+        Ok(Vector::<N>::from_column_slice(&a))
     };
     let eigenvector = vec2(&doc["linear"]["eigenvector"], "linear.eigenvector")?;
     if let Some(name) = doc["family"].as_str() {
@@ -239,13 +245,13 @@ fn chart_from_json(path: &Path, energy: f64, family: Family) -> anyhow::Result<C
     let coefficients: Vec<Vec<f64>> =
         serde_json::from_value(best.1["chart"]["coefficients"].clone())
             .context("modes[].chart.coefficients must be lists of numbers")?;
-    let [c1, c2]: [Vec<f64>; 2] = coefficients
+    let per_joint: [Vec<f64>; N] = coefficients
         .try_into()
-        .map_err(|_| anyhow::anyhow!("chart.coefficients must have one list per joint (2)"))?;
+        .map_err(|_| anyhow::anyhow!("chart.coefficients must have one list per joint ({N})"))?;
     Ok(Chart::from_coefficients(
         eigenvector,
-        Vector::<2>::zeros(),
-        [c1, c2],
+        Vector::<N>::zeros(),
+        per_joint,
     )?)
 }
 
@@ -273,14 +279,28 @@ fn parse_schedule(text: &str) -> anyhow::Result<Vec<(f64, f64)>> {
     Ok(out)
 }
 
-/// Runs the subcommand.
+/// Runs the subcommand for the robot's joint count.
 pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
+    let n = args.model.joint_count()?;
+    eigenmpc::with_joint_count!(
+        n,
+        |N, S, NP| run_simulate_for::<N, S, NP>(args),
+        otherwise Err(anyhow::anyhow!(eigenmpc::joints::unsupported(n)))
+    )
+}
+
+fn run_simulate_for<const N: usize, const S: usize, const NP: usize>(
+    args: &SimulateArgs,
+) -> anyhow::Result<()> {
     let variant: Variant = args.variant.parse().map_err(anyhow::Error::msg)?;
     let family: Family = args.family.parse().map_err(anyhow::Error::msg)?;
     let backend: QpBackend = args.qp.parse().map_err(anyhow::Error::msg)?;
-    let x0 = super::parse_list("x0", &args.x0)?;
-    if x0.len() != 4 || x0.iter().any(|v| !v.is_finite()) {
-        bail!("--x0 needs 4 finite numbers q1,q2,qd1,qd2");
+    let x0 = match &args.x0 {
+        Some(text) => super::parse_list("x0", text)?,
+        None => (0..S).map(|i| if i < N { 0.05 } else { 0.0 }).collect(),
+    };
+    if x0.len() != S || x0.iter().any(|v| !v.is_finite()) {
+        bail!("--x0 needs {S} finite numbers q1..q{N},qd1..qd{N} (the robot has {N} joints)");
     }
     if !(args.duration.is_finite() && args.duration > 0.0 && args.duration <= 3600.0) {
         bail!("--duration must be in (0, 3600] s");
@@ -317,10 +337,10 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
         Some(text) => parse_schedule(text)?,
         None => vec![],
     };
-    let robot = args.model.robot()?;
+    let robot = args.model.robot_of::<N>()?;
     // The controller's model (before its prediction's Coulomb slope) and
     // the plant it drives: the same robot unless --plant says otherwise.
-    let system: DoublePendulum = robot.system;
+    let system: PlanarChain<N> = robot.system;
     let plant_robot = match &args.plant {
         Some(path) => Some(plant_from_file(path, &robot)?),
         None => None,
@@ -380,7 +400,7 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
     let model = system.with_coulomb_sharpness(sharpness)?;
     if args.adapt {
         // Refused before the mode family is computed, not after.
-        BaseParameters::<2, NP>::of(model.params()).context("--adapt")?;
+        BaseParameters::<N, NP>::of(model.params()).context("--adapt")?;
     }
     let e_final = schedule.last().map_or(args.energy, |s| s.1);
     // With --adapt a chart variant follows its model's mode family, as the
@@ -402,14 +422,14 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
             degree: args.chart_degree,
             ..defaults
         };
-        let chart_family = ChartFamily::compute::<_, 4>(&model, family.index(), &opts)
+        let chart_family = ChartFamily::compute::<_, S>(&model, family.index(), &opts)
             .with_context(|| format!("{family} mode family up to {e_max} J"))?;
         let (lo, hi) = chart_family.energy_range();
         eprintln!("{family} mode family: charts for {lo:.4} .. {hi:.4} J");
         if let Some(why) = chart_family.ended_early() {
             eprintln!("  (ends below {e_max} J: {why})");
         }
-        Controller::<_, 2, 4>::with_family_as(model, config, chart_family, variant)?
+        Controller::<_, N, S>::with_family_as(model, config, chart_family, variant)?
     } else {
         let reference = match variant {
             Variant::Straight => Reference::Straight {
@@ -420,7 +440,7 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
                 match &args.chart {
                     Some(path) => chart_from_json(path, args.energy, family)?,
                     None => {
-                        mode_and_chart::<_, 2, 4>(
+                        mode_and_chart::<_, N, S>(
                             &model,
                             family.index(),
                             args.energy,
@@ -432,9 +452,9 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
                 },
             ),
         };
-        Controller::<_, 2, 4>::new(model, config, reference)?
+        Controller::<_, N, S>::new(model, config, reference)?
     };
-    let (mode, _) = mode_and_chart::<_, 2, 4>(&plant, family.index(), e_final, 9)
+    let (mode, _) = mode_and_chart::<_, N, S>(&plant, family.index(), e_final, 9)
         .with_context(|| format!("{family} eigenmode of the plant at {e_final} J"))?;
     let mut adaptation = if args.adapt {
         let options = AdaptOptions {
@@ -444,18 +464,18 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
             ..AdaptOptions::default()
         };
         Some(
-            Adaptation::<2, 4, NP>::new(controller.system().params(), options)
+            Adaptation::<N, S, NP>::new(controller.system().params(), options)
                 .context("--adapt")?,
         )
     } else {
         None
     };
     let mut adapted: Vec<AdaptationSample<NP>> = vec![];
-    let z0 = SVector::<f64, 4>::from_column_slice(&x0);
+    let z0 = SVector::<f64, S>::from_column_slice(&x0);
     let mut next = 0;
     let mut noise = GaussianNoise::new(args.seed);
     // Before the first sample the plant rested at z0.
-    let mut history: std::collections::VecDeque<SVector<f64, 4>> =
+    let mut history: std::collections::VecDeque<SVector<f64, S>> =
         std::iter::repeat_n(z0, args.delay_samples).collect();
     let dt = config.dt;
     let trace = run_measured_with(
@@ -487,8 +507,8 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
             // solve used (the EKF's estimate when it runs) and the torque
             // that acted over the sample before the measurement.
             let used = c.state_estimate().copied().unwrap_or(*measured);
-            let q = Vector::<2>::new(used[0], used[1]);
-            let qd = Vector::<2>::new(used[2], used[3]);
+            let q = Vector::<N>::from_fn(|j, _| used[j]);
+            let qd = Vector::<N>::from_fn(|j, _| used[N + j]);
             let felt = c.torque_before_measurement();
             a.sample(c, &q, &qd, &felt, dt);
             adapted.push(AdaptationSample {
@@ -509,7 +529,7 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
             robot_name(&robot)
         )
     });
-    print_summary(args, variant, family, setup.as_deref(), &summary);
+    print_summary(args, variant, family, &x0, setup.as_deref(), &summary);
     let (mean, rms) = energy_tail(&trace, e_final, 5.0);
     let window = window_label(summary.window);
     println!(
@@ -521,12 +541,16 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
     if plant.params().has_friction() {
         let f = rms_friction_torque(&trace, &plant, 5.0);
         let t = summary.rms_torque;
+        let per_joint = |v: &dyn Fn(usize) -> f64, digits: usize| {
+            (0..N)
+                .map(|j| format!("{:.digits$}", v(j)))
+                .collect::<Vec<_>>()
+                .join(" / ")
+        };
         println!(
-            "RMS friction torque along the final orbit, {window}: {:.4} / {:.4} N m (torque / friction: {:.2} / {:.2}, combined {:.2})",
-            f[0],
-            f[1],
-            t[0] / f[0],
-            t[1] / f[1],
+            "RMS friction torque along the final orbit, {window}: {} N m (torque / friction: {}, combined {:.2})",
+            per_joint(&|j| f[j], 4),
+            per_joint(&|j| t[j] / f[j], 2),
             t.norm() / f.norm()
         );
         println!(
@@ -537,17 +561,17 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
     }
     // The plant's base parameters (None with joint springs: its energy is
     // not linear in them) and the model's before any adaptation.
-    let truth = BaseParameters::<2, NP>::of(plant.params())
+    let truth = BaseParameters::<N, NP>::of(plant.params())
         .ok()
         .map(|b| b.theta);
-    let names = base_parameter_names::<2>();
+    let names = base_parameter_names::<N>();
     if args.adapt {
-        let start = BaseParameters::<2, NP>::of(system.params())
+        let start = BaseParameters::<N, NP>::of(system.params())
             .context("--adapt")?
             .theta;
         print!(
             "{}",
-            adaptation::summary_text::<2, NP>(
+            adaptation::summary_text::<N, NP>(
                 &names,
                 &adapted,
                 &start,
@@ -555,7 +579,7 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
                 system.params().joints[0].gear_ratio
             )
         );
-        let gears = |p: &DoublePendulum| p.params().joints.map(|j| j.gear_ratio);
+        let gears = |p: &PlanarChain<N>| p.params().joints.map(|j| j.gear_ratio);
         if gears(&plant) != gears(&system) {
             println!(
                 "  (the plant's gear ratios differ from the model's, which the identification \
@@ -603,17 +627,18 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn print_summary(
+fn print_summary<const N: usize>(
     args: &SimulateArgs,
     variant: Variant,
     family: Family,
+    x0: &[f64],
     setup: Option<&str>,
-    s: &Summary<2>,
+    s: &Summary<N>,
 ) {
     println!(
         "{variant} EigenMPC, {family}, E_ref = {} J, x0 = {}, {} s, N = {}, dt = {} s, QP {}",
         args.energy,
-        args.x0,
+        x0.iter().map(|v| number(*v)).collect::<Vec<_>>().join(","),
         args.duration,
         args.horizon,
         args.dt,
