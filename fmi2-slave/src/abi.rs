@@ -105,7 +105,7 @@ pub unsafe fn instantiate<M: Model>(
     instance_name: ffi::fmi2String,
     fmu_type: ffi::fmi2Type,
     guid: ffi::fmi2String,
-    _resource_location: ffi::fmi2String,
+    resource_location: ffi::fmi2String,
     functions: *const ffi::fmi2CallbackFunctions,
     _visible: ffi::fmi2Boolean,
     logging_on: ffi::fmi2Boolean,
@@ -140,7 +140,11 @@ pub unsafe fn instantiate<M: Model>(
             log.error("fmi2Instantiate: fmuGUID is NULL");
             return ptr::null_mut();
         };
-        match Instance::<M>::new(log, &guid) {
+        // An unusable location is no error for an FMU that needs no
+        // resources: the description says (Model::description_for).
+        let resources =
+            c_str(resource_location).and_then(|uri| crate::resources::resource_dir(&uri));
+        match Instance::<M>::with_resources(log, &guid, resources) {
             Some(instance) => Box::into_raw(Box::new(instance)) as ffi::fmi2Component,
             None => ptr::null_mut(),
         }

@@ -8,6 +8,7 @@ use crate::values::Values;
 use crate::variables::compact;
 use crate::variables::{BaseType, Causality, Initial, ModelDescription, Value, Variability};
 use std::fmt;
+use std::path::{Path, PathBuf};
 
 /// The FMI 2.0 Co-Simulation states an instance can be in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -68,6 +69,8 @@ pub struct Context<'a> {
     pub log: &'a Logger,
     /// The experiment set up by the host.
     pub experiment: &'a Experiment,
+    /// The FMU's unpacked `resources/` folder, when the host gave one.
+    pub resources: Option<&'a Path>,
 }
 
 /// Why a model call failed.
@@ -104,6 +107,16 @@ impl fmt::Display for ModelError {
 pub trait Model: Sized + Send + 'static {
     /// The model's identity and variable table (drives dispatch and XML).
     fn description() -> ModelDescription;
+
+    /// The description of an instance whose FMU has its `resources/` folder
+    /// at `resources` (`None`: the host gave none). A model whose variables
+    /// or start values come from its archive (a robot exported by `eigenmpc
+    /// export`) reads them there; an error makes `fmi2Instantiate` fail with
+    /// that message. The default is [`Model::description`].
+    fn description_for(resources: Option<&Path>) -> Result<ModelDescription, String> {
+        let _ = resources;
+        Ok(Self::description())
+    }
 
     /// Builds the model from the parameters and inputs in `values` and writes
     /// the outputs for them. Called at `fmi2ExitInitializationMode`, and
@@ -156,6 +169,8 @@ pub trait Model: Sized + Send + 'static {
 pub struct Instance<M: Model> {
     log: Logger,
     description: ModelDescription,
+    /// The FMU's `resources/` folder (from `fmuResourceLocation`).
+    resources: Option<PathBuf>,
     guid: String,
     values: Values,
     state: State,
@@ -215,7 +230,19 @@ impl<M: Model> Instance<M> {
     /// `fmi2Instantiate`: checks the GUID against the model's; logs and
     /// returns `None` on mismatch or an invalid variable table.
     pub fn new(log: Logger, guid: &str) -> Option<Self> {
-        let description = M::description();
+        Self::with_resources(log, guid, None)
+    }
+
+    /// `fmi2Instantiate` of an FMU unpacked with its `resources/` folder at
+    /// `resources`: the description is [`Model::description_for`] it.
+    pub fn with_resources(log: Logger, guid: &str, resources: Option<PathBuf>) -> Option<Self> {
+        let description = match M::description_for(resources.as_deref()) {
+            Ok(d) => d,
+            Err(e) => {
+                log.error(&format!("fmi2Instantiate: {e}"));
+                return None;
+            }
+        };
         if let Err(e) = description.validate() {
             log.error(&format!("fmi2Instantiate: invalid variable table: {e}"));
             return None;
@@ -236,6 +263,7 @@ impl<M: Model> Instance<M> {
         Some(Self {
             log,
             description,
+            resources,
             guid: expected,
             values,
             state: State::Instantiated,
@@ -383,6 +411,7 @@ impl<M: Model> Instance<M> {
         let ctx = Context {
             log: &self.log,
             experiment: &self.experiment,
+            resources: self.resources.as_deref(),
         };
         let initial_values = self.values.all().to_vec();
         let model = M::initialize(&mut self.values, &ctx).map_err(|e| format!("{func}: {e}"))?;
@@ -551,6 +580,7 @@ impl<M: Model> Instance<M> {
                 let ctx = Context {
                     log: &self.log,
                     experiment: &self.experiment,
+                    resources: self.resources.as_deref(),
                 };
                 let model = self
                     .model
@@ -691,6 +721,7 @@ impl<M: Model> Instance<M> {
             let ctx = Context {
                 log: &self.log,
                 experiment: &self.experiment,
+                resources: self.resources.as_deref(),
             };
             let model = self
                 .model
@@ -881,6 +912,7 @@ impl<M: Model> Instance<M> {
             let ctx = Context {
                 log: &self.log,
                 experiment: &snapshot.experiment,
+                resources: self.resources.as_deref(),
             };
             let model = match &snapshot.model {
                 None => None,

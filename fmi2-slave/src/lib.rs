@@ -13,6 +13,7 @@
 //! - [`table`]: declarative tables parameterised by the number of joints,
 //!   from which the variables, value references, settings, C constants and
 //!   Markdown tables follow;
+//! - [`resources`]: the `fmuResourceLocation` URI as a folder;
 //! - [`state`]: FMU state save and restore, and its versioned byte form;
 //! - [`abi`]: the C entry points, generic over the model, with null checks
 //!   and `catch_unwind` (no panic crosses the C ABI);
@@ -40,6 +41,7 @@ pub mod abi;
 mod export;
 pub mod instance;
 pub mod logger;
+pub mod resources;
 pub mod state;
 pub mod table;
 pub mod testing;

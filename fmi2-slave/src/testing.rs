@@ -164,10 +164,25 @@ impl TestInstance {
     /// Instantiates `M` through `instantiate` (the crate's exported
     /// `fmi2Instantiate`) with the GUID of its description; panics on NULL.
     pub fn new<M: crate::Model>(instantiate: ffi::fmi2InstantiateTYPE, name: &str) -> Self {
+        Self::with_resources::<M>(instantiate, name, None)
+    }
+
+    /// As [`TestInstance::new`], for an FMU unpacked with its `resources/`
+    /// folder at `resources` (given to the FMU as a `file:///` URI; the
+    /// GUID is that of [`crate::Model::description_for`] the folder).
+    pub fn with_resources<M: crate::Model>(
+        instantiate: ffi::fmi2InstantiateTYPE,
+        name: &str,
+        resources: Option<&std::path::Path>,
+    ) -> Self {
         let log = LogCapture::new();
         let callbacks = Box::new(log.callbacks());
         let name = std::ffi::CString::new(name).expect("instance name");
-        let guid = std::ffi::CString::new(crate::xml::guid(&M::description())).expect("guid");
+        let description = M::description_for(resources).expect("description for the resources");
+        let guid = std::ffi::CString::new(crate::xml::guid(&description)).expect("guid");
+        let location = resources.map(|dir| {
+            std::ffi::CString::new(format!("file://{}", dir.display())).expect("resource URI")
+        });
         let instantiate = instantiate.expect("fmi2Instantiate");
         // SAFETY: valid NUL-terminated strings and callbacks that outlive the
         // instance (kept in the returned value).
@@ -176,7 +191,7 @@ impl TestInstance {
                 name.as_ptr(),
                 ffi::fmi2Type_fmi2CoSimulation,
                 guid.as_ptr(),
-                std::ptr::null(),
+                location.as_ref().map_or(std::ptr::null(), |l| l.as_ptr()),
                 &*callbacks,
                 0,
                 0,

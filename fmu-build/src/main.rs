@@ -16,13 +16,12 @@
 //!
 //! Adding an FMU is one entry in [`FMUS`].
 
-mod ssp;
+use fmu_build::archive;
+use fmu_build::ssp;
 
 use anyhow::{Context, Result, bail};
-use std::io::Write;
 use std::path::PathBuf;
 use std::process::Command;
-use zip::write::SimpleFileOptions;
 
 /// One FMU: its cargo package and what the build produces.
 struct FmuSpec {
@@ -89,9 +88,6 @@ const FMUS: &[FmuSpec] = &[
         header_unprefixed: &[],
     },
 ];
-
-/// Where the FMU binaries go inside the archive (FMI 2.0 platform name).
-const PLATFORM: &str = "linux64";
 
 struct Workspace {
     root: PathBuf,
@@ -167,11 +163,11 @@ fn describe(ws: &Workspace, fmu: &FmuSpec) -> Result<(String, String)> {
 /// `target/fmu/<modelIdentifier>.so.debug`, linked by `.gnu_debuglink` for
 /// debuggers. Needs binutils' `objcopy` (Debian `binutils`, installed with
 /// gcc by `tests/run.sh`).
-fn stripped_binary(ws: &Workspace, fmu: &FmuSpec) -> Result<Vec<u8>> {
-    let library = ws.target.join("release").join(fmu.library);
+fn stripped_binary(ws: &Workspace, library: &str, name: &str) -> Result<Vec<u8>> {
+    let library = ws.target.join("release").join(library);
     let dir = ws.target.join("fmu");
-    let debug = dir.join(format!("{}.so.debug", fmu.model_identifier));
-    let stripped = dir.join(format!("{}.so", fmu.model_identifier));
+    let debug = dir.join(format!("{name}.so.debug"));
+    let stripped = dir.join(format!("{name}.so"));
     let objcopy = |args: &[&std::ffi::OsStr]| -> Result<()> {
         let status = Command::new("objcopy")
             .args(args)
@@ -200,25 +196,33 @@ fn stripped_binary(ws: &Workspace, fmu: &FmuSpec) -> Result<Vec<u8>> {
 }
 
 fn package(ws: &Workspace, fmu: &FmuSpec, xml: &str, html: &str) -> Result<PathBuf> {
-    let binary = stripped_binary(ws, fmu)?;
+    let binary = stripped_binary(ws, fmu.library, fmu.model_identifier)?;
     let path = ws
         .target
         .join("fmu")
         .join(format!("{}.fmu", fmu.model_identifier));
-    let file = std::fs::File::create(&path)?;
-    let mut zip = zip::ZipWriter::new(file);
-    let opts = SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
-    let exe = opts.unix_permissions(0o755);
-    zip.start_file("modelDescription.xml", opts)?;
-    zip.write_all(xml.as_bytes())?;
-    zip.start_file(
-        format!("binaries/{PLATFORM}/{}.so", fmu.model_identifier),
-        exe,
-    )?;
-    zip.write_all(&binary)?;
-    zip.start_file("documentation/index.html", opts)?;
-    zip.write_all(html.as_bytes())?;
-    zip.finish()?;
+    archive::write_fmu(&path, fmu.model_identifier, xml, &binary, html, &[])?;
+    Ok(path)
+}
+
+/// The exported robots' binary (`eigenmpc export` copies it into every
+/// FMU it writes), stripped, at [`archive::robot_binary_path`].
+fn robot_binary(ws: &Workspace) -> Result<PathBuf> {
+    let robot = FmuSpec {
+        model_identifier: "eigenmpc_robot",
+        package: "eigenmpc-robot-fmu",
+        dir: "robot-fmu",
+        library: "libeigenmpc_robot.so",
+        describe: "",
+        header_prefix: "",
+        c_api: false,
+        header_unprefixed: &[],
+    };
+    release_build(ws, &robot)?;
+    let binary = stripped_binary(ws, robot.library, robot.model_identifier)?;
+    let path = archive::robot_binary_path(&ws.target.join("fmu"));
+    std::fs::create_dir_all(path.parent().context("robot binary folder")?)?;
+    std::fs::write(&path, binary)?;
     Ok(path)
 }
 
@@ -327,6 +331,11 @@ fn main() -> Result<()> {
         let path = package(&ws, fmu, &xml, &html)?;
         println!("wrote {}", path.display());
     }
+    let robot = robot_binary(&ws)?;
+    println!(
+        "wrote {} (the binary of `eigenmpc export`)",
+        robot.display()
+    );
     for spec in ssp::SSPS {
         let path = ssp::package(&ws.target.join("fmu"), spec)?;
         println!("wrote {}", path.display());

@@ -11,19 +11,19 @@ use std::path::{Path, PathBuf};
 use zip::write::SimpleFileOptions;
 
 /// One closed loop shipped as an SSP.
-pub struct SspSpec {
+pub struct SspSpec<'a> {
     /// Archive name (`<name>.ssp`).
-    pub name: &'static str,
+    pub name: &'a str,
     /// The controller FMU's `modelIdentifier`.
-    pub controller: &'static str,
+    pub controller: &'a str,
     /// The plant FMU's `modelIdentifier`.
-    pub plant: &'static str,
+    pub plant: &'a str,
     /// Joints of the chain.
     pub joints: usize,
 }
 
 /// The closed loops this workspace ships.
-pub const SSPS: &[SspSpec] = &[
+pub const SSPS: &[SspSpec<'static>] = &[
     SspSpec {
         name: "EigenMPC-DoublePendulum",
         controller: "EigenMPC",
@@ -103,7 +103,7 @@ fn component(
 }
 
 /// `SystemStructure.ssd` of `spec`.
-pub fn system_structure(spec: &SspSpec) -> String {
+pub fn system_structure(spec: &SspSpec<'_>) -> String {
     let joints: Vec<usize> = (1..=spec.joints).collect();
     let state: Vec<String> = joints
         .iter()
@@ -170,7 +170,7 @@ pub fn system_structure(spec: &SspSpec) -> String {
 }
 
 /// Writes `<fmu_dir>/<name>.ssp` from the FMUs already packaged there.
-pub fn package(fmu_dir: &Path, spec: &SspSpec) -> Result<PathBuf> {
+pub fn package(fmu_dir: &Path, spec: &SspSpec<'_>) -> Result<PathBuf> {
     let path = fmu_dir.join(format!("{}.ssp", spec.name));
     let mut zip = zip::ZipWriter::new(std::fs::File::create(&path)?);
     let opts = SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);

@@ -12,6 +12,8 @@
 //!
 //! - [`enums`]: the `variant` and `qp_solver` enumerations (name, item,
 //!   description), one table used by the FMU and the C API;
+//! - [`exported`]: the model of every robot `eigenmpc export` writes (one
+//!   binary, any joint count, controller or plant, told by its resources);
 //! - [`chain`]: the rigid-link parameters shared by controller and plant;
 //! - [`units`]: unit definitions;
 //! - [`readme`]: the README's FMU variable tables.
@@ -19,6 +21,7 @@
 pub mod chain;
 pub mod controller;
 pub mod enums;
+pub mod exported;
 pub mod plant;
 pub mod products;
 pub mod readme;

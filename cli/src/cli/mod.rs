@@ -1,6 +1,7 @@
 //! Command-line interface. Errors are printed as one line on stderr with a
 //! non-zero exit code, never as a panic trace.
 
+mod export;
 mod modes;
 mod paper;
 mod robustness;
@@ -38,6 +39,9 @@ enum Command {
     /// The paper's section V figures and the hybrid experiment from this engine, and
     /// report.md with each claim of the paper next to the measured figure and a verdict.
     Paper(paper::PaperArgs),
+    /// A robot file (1 to 6 joints) as a controller FMU, a plant FMU and the SSP that couples
+    /// them, each validated; no compiler needed.
+    Export(export::ExportArgs),
 }
 
 /// The robot: a parameter file, or the paper's point-mass double pendulum
@@ -99,6 +103,18 @@ pub struct Robot<const N: usize = 2> {
 }
 
 impl ModelArgs {
+    /// The robot of the parameter file `path`.
+    pub fn for_file(path: &std::path::Path) -> Self {
+        Self {
+            model: Some(path.to_path_buf()),
+            m1: 1.0,
+            m2: 1.0,
+            l1: 1.0,
+            l2: 1.0,
+            g: 9.81,
+        }
+    }
+
     /// The robot's joint count: the parameter file's links, or 2 for the
     /// point-mass pendulum of `--m1 .. --g`. A count outside the joint-count
     /// table is an error.
@@ -244,6 +260,7 @@ pub fn main() -> ExitCode {
         Command::Robustness(args) => robustness::run(&args),
         Command::Sweep(args) => sweep::run_sweep(&args),
         Command::Paper(args) => paper::run(&args),
+        Command::Export(args) => export::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -156,12 +156,22 @@ struct SavedController<const N: usize, const NX: usize, const NP: usize> {
 
 /// The model description of product `P`.
 pub fn description<P: ControllerProduct<N>, const N: usize>() -> ModelDescription {
+    description_with(P::MODEL_NAME, P::DESCRIPTION, &P::settings(Variant::Curved))
+}
+
+/// The model description of an `N`-joint controller FMU called `name`
+/// whose start values are `defaults` (a product's, or an exported robot's).
+pub fn description_with<const N: usize>(
+    name: &str,
+    text: &str,
+    defaults: &Settings<N>,
+) -> ModelDescription {
     let t = table::table::<N>();
-    let variables = t.variables(&P::settings(Variant::Curved));
+    let variables = t.variables(defaults);
     ModelDescription {
-        model_name: P::MODEL_NAME.into(),
-        model_identifier: P::MODEL_NAME.into(),
-        description: P::DESCRIPTION.into(),
+        model_name: name.into(),
+        model_identifier: name.into(),
+        description: text.into(),
         version: env!("CARGO_PKG_VERSION").into(),
         author: "EigenMPC project".into(),
         generation_tool: format!("fmi2-slave (EigenMPC) {}", env!("CARGO_PKG_VERSION")),
