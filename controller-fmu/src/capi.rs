@@ -11,7 +11,7 @@
 //! eigenmpc_free(mpc);
 //! ```
 //!
-//! Any robot, 2 or 3 joints: `eigenmpc_create_named` takes the controller
+//! Any robot, 1 to 6 joints (`eigenmpc::joints`): `eigenmpc_create_named` takes the controller
 //! FMU's parameter names and values (`m[1]`, `r[1]`, `I[1]`, `cf[2]`,
 //! `E_ref`, `chart_source`, ...; every rigid-link parameter), checked and
 //! defaulted by the FMU's own variable table.
@@ -24,10 +24,10 @@ use crate::STATUS_BAD_ARGUMENT;
 use eigenmpc::mpc::{ControlStatus, CostParams, Variant};
 use eigenmpc_fmu_models::controller::ControllerProduct;
 use eigenmpc_fmu_models::controller::adaptive::AdaptiveController;
-use eigenmpc_fmu_models::controller::named::{check_named, settings_from_named};
+use eigenmpc_fmu_models::controller::named::settings_from_named;
 use eigenmpc_fmu_models::controller::settings::{ChartSource, Settings, Tuning};
 use eigenmpc_fmu_models::enums::{ADAPTATION_STATUS, CHART_SOURCE, QP_SOLVER};
-use eigenmpc_fmu_models::products::{EigenMpc2, EigenMpc3};
+use eigenmpc_fmu_models::products::{self, EigenMpc2};
 use nalgebra::SVector;
 use std::ffi::{CStr, CString, c_char};
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -204,7 +204,7 @@ impl<const N: usize, const NX: usize, const NP: usize> JointController
 
 /// An EigenMPC controller (opaque). Create with [`eigenmpc_create`] (the
 /// paper's double pendulum, point masses) or [`eigenmpc_create_named`] (any
-/// robot, 2 or 3 joints), free with [`eigenmpc_free`].
+/// robot, 1 to 6 joints), free with [`eigenmpc_free`].
 pub struct EigenMpc {
     controller: Box<dyn JointController>,
     variant: Variant,
@@ -290,14 +290,14 @@ fn in_config_terms(message: String, fields: &[(&str, &str, f64)]) -> String {
 
 /// Checks a tunable as the controller FMU of `joints` joints does.
 fn check_tunable(joints: usize, name: &str, v: f64) -> Result<(), String> {
-    match joints {
-        2 => check_named::<EigenMpc2, 2>(name, v),
-        3 => check_named::<EigenMpc3, 3>(name, v),
+    eigenmpc::with_joint_count!(
+        joints,
+        |N, S, NP| products::check_named::<N>(name, v),
         // Never a default: a handle of another joint count is a bug.
-        n => Err(format!(
-            "{name}: no {n}-joint controller to check it against"
-        )),
-    }
+        otherwise Err(format!(
+            "{name}: no {joints}-joint controller to check it against"
+        ))
+    )
 }
 
 fn settings_from(config: &EigenMpcConfig) -> Result<Settings<2>, String> {
@@ -453,8 +453,9 @@ unsafe fn finish_create(
     std::ptr::null_mut()
 }
 
-/// Creates a controller for `joints` = 2 (the `EigenMPC` FMU's parameters)
-/// or 3 (`EigenMPC3`'s) from parameter names and values: `count` pairs
+/// Creates a controller for `joints` = 1 to 6 (2: the `EigenMPC` FMU's
+/// parameters and defaults, 3: `EigenMPC3`'s, others: an exported robot's,
+/// whose chart is computed from the model) from parameter names and values: `count` pairs
 /// `names[i]` = `values[i]`, any parameter of that FMU's variable table
 /// (README, "FMI 2.0 co-simulation FMUs"): the model (`m[j]`, `l[j]`, `g`,
 /// `r[j]`, `I[j]`, `Ir[j]`, `gr[j]`, `b[j]`, `cf[j]`, `k[j]`, `q_rest[j]`,
@@ -498,17 +499,18 @@ pub unsafe extern "C" fn eigenmpc_create_named(
                 .map_err(|_| format!("names[{i}] is not UTF-8"))?;
             pairs.push((name, value));
         }
-        match joints {
-            2 => handle::<2, 4, 11>(&settings_from_named::<EigenMpc2, 2>(&pairs)?),
-            3 => handle::<3, 6, 18>(&settings_from_named::<EigenMpc3, 3>(&pairs)?),
-            n => Err(format!("joints = {n}: 2 or 3 are available")),
-        }
+        let n = joints as usize;
+        eigenmpc::with_joint_count!(
+            n,
+            |N, S, NP| handle::<N, S, NP>(&products::settings_from_named::<N>(&pairs)?),
+            otherwise Err(format!("joints = {n}: {}", eigenmpc::joints::unsupported(n)))
+        )
     }));
     // SAFETY: the caller's guarantee on `error`.
     unsafe { finish_create("eigenmpc_create_named", result, error, error_len) }
 }
 
-/// Number of joints of the handle's controller (2 or 3), or
+/// Number of joints of the handle's controller (1 to 6), or
 /// `EIGENMPC_STATUS_BAD_ARGUMENT` for a NULL handle.
 ///
 /// # Safety

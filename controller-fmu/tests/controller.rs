@@ -693,7 +693,7 @@ fn c_api_steps_like_the_controller() {
     }
 }
 
-/// `eigenmpc_create_named`: FMU parameter names for 2 and 3 joints; the
+/// `eigenmpc_create_named`: FMU parameter names for 2, 3 and 4 joints; the
 /// 3-joint handle steps exactly like the `EigenMPC3` FMU's controller, and
 /// a rigid-link model with friction given by name is the controller's model.
 #[test]
@@ -777,13 +777,50 @@ fn c_api_creates_any_robot_from_parameter_names() {
     assert!((info.energy - native.energy(&z)).abs() < 1e-15);
     unsafe { eigenmpc_free(mpc) };
 
+    // any joint count of the table: a 4-link chain of point masses (its
+    // chart computed from the model, as an exported robot's)
+    let four = [
+        ("m[1]", 0.5),
+        ("m[2]", 0.5),
+        ("m[3]", 0.5),
+        ("m[4]", 0.5),
+        ("l[1]", 0.4),
+        ("l[2]", 0.4),
+        ("l[3]", 0.4),
+        ("l[4]", 0.4),
+        ("E_ref", 1.0),
+    ];
+    let (mpc, err) = named(4, &four);
+    assert!(!mpc.is_null(), "{err}");
+    assert_eq!(unsafe { eigenmpc_joints(mpc) }, 4);
+    let mut settings = eigenmpc_fmu_models::products::default_settings::<4>(Variant::Curved);
+    settings.model.mass = [0.5; 4];
+    settings.model.length = [0.4; 4];
+    settings.tuning.e_ref = 1.0;
+    let mut native = settings.build::<8>().unwrap();
+    let z = SVector::<f64, 8>::from_column_slice(&[0.05, 0.05, 0.05, 0.05, 0.0, 0.0, 0.0, 0.0]);
+    let mut tau = [f64::NAN; 4];
+    let expected = native.step(&z);
+    assert_eq!(
+        unsafe { eigenmpc_step(mpc, z.as_ptr(), tau.as_mut_ptr()) },
+        expected.status.code()
+    );
+    assert_eq!(tau.as_slice(), expected.tau.as_slice());
+    unsafe { eigenmpc_free(mpc) };
+
     // refused with the FMU's messages
     for (joints, pairs, needle) in [
         (2, vec![("m[3]", 1.0)], "m[3] is not a variable of EigenMPC"),
         (3, vec![("q[1]", 0.1)], "q[1] is not a parameter"),
         (2, vec![("cf[1]", -1.0)], "cf[1] = -1 is below its minimum"),
         (2, vec![("mode", 1.5)], "mode = 1.5 must be an integer"),
-        (4, vec![], "joints = 4"),
+        (7, vec![], "joints = 7: 7 joints are not supported"),
+        (0, vec![], "joints = 0"),
+        (
+            4,
+            vec![("m[5]", 1.0)],
+            "m[5] is not a variable of the 4-joint controller",
+        ),
     ] {
         let (mpc, err) = named(joints, &pairs);
         assert!(mpc.is_null());

@@ -2,8 +2,9 @@
 //! `DoublePendulum` (the paper's) and the 3-link pair `EigenMPC3` /
 //! `TriplePendulum`, each a product of the generic models.
 
-use crate::controller::settings::CHART_COEFFICIENTS;
+use crate::controller::settings::{CHART_COEFFICIENTS, Settings};
 use crate::controller::{ControllerFmu, ControllerProduct};
+use crate::exported::Exported;
 use crate::plant::{PlantFmu, PlantProduct};
 use eigenmpc::mpc::Variant;
 use fmi2_slave::table::RowDoc;
@@ -189,4 +190,45 @@ pub fn plant_docs() -> Vec<(&'static str, Vec<RowDoc>)> {
             table::<3>().docs(&PlantSettings::default()),
         ),
     ]
+}
+
+/// The controller settings a handle of `N` joints starts from: the shipped
+/// product's for 2 (`EigenMPC`) and 3 (`EigenMPC3`) joints, the library's
+/// defaults otherwise (an exported robot's: chart computed from the model).
+pub fn default_settings<const N: usize>(variant: Variant) -> Settings<N> {
+    use std::any::Any;
+    // A product exists for some counts only: the downcast is the identity
+    // exactly when N is that count.
+    let shipped: Option<Box<dyn Any>> = match N {
+        2 => Some(Box::new(EigenMpc2::settings(variant))),
+        3 => Some(Box::new(EigenMpc3::settings(variant))),
+        _ => None,
+    };
+    shipped
+        .and_then(|s| s.downcast::<Settings<N>>().ok())
+        .map_or_else(
+            || <Exported as ControllerProduct<N>>::settings(variant),
+            |s| *s,
+        )
+}
+
+/// The `N`-joint controller settings with the FMU parameters `(name, value)`
+/// set over [`default_settings`], each checked as `fmi2Set*` would check it
+/// (the C API's `eigenmpc_create_named` for any joint count).
+pub fn settings_from_named<const N: usize>(values: &[(&str, f64)]) -> Result<Settings<N>, String> {
+    let defaults = default_settings::<N>(Variant::Curved);
+    let name = match N {
+        2 => EigenMpc2::MODEL_NAME.to_string(),
+        3 => EigenMpc3::MODEL_NAME.to_string(),
+        n => format!("the {n}-joint controller"),
+    };
+    let d = crate::controller::description_with::<N>(&name, "", &defaults);
+    crate::controller::table::table::<N>().settings_from_named(&d, defaults, values)
+}
+
+/// Checks `name = x` as `fmi2Set*` would for an `N`-joint controller (the
+/// ranges do not depend on the product).
+pub fn check_named<const N: usize>(name: &str, x: f64) -> Result<(), String> {
+    fmi2_slave::table::named_value(&crate::controller::description::<Exported, N>(), name, x)
+        .map(|_| ())
 }
