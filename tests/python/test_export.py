@@ -106,7 +106,7 @@ def test_the_exported_pair_closes_the_loop_under_fmpy(exported, key, tmp_path):
     rms = [math.sqrt(sum(t[j] ** 2 for t in last) / len(last)) for j in range(joints)]
     FIGURES.append(
         f"fmpy, exported {name} ({joints} joints), E_ref {energy_ref} J, {seconds:.0f} s: 5 % band for good at "
-        f"{band} s, final E = {energies[-1]:.4f} J, RMS torque last 5 s = " + " / ".join(f"{r:.4f}" for r in rms) + " N m"
+        f"{band:.3f} s, final E = {energies[-1]:.4f} J, RMS torque last 5 s = " + " / ".join(f"{r:.4f}" for r in rms) + " N m"
     )
     assert band is not None and band < seconds - 5.0
     assert abs(energies[-1] - energy_ref) < 0.02 * energy_ref

@@ -291,14 +291,76 @@ pub struct RiccatiSolver {
     warm_next: bool,
 }
 
-/// The core for the solver's dimensions: compile-time-sized for the 1-, 2-
-/// and 3-joint chains, runtime-sized otherwise.
-#[derive(Clone, Debug)]
+/// The core for the solver's dimensions: compile-time-sized for the chains
+/// of the joint-count table (`nx = 2 nu`, `nu` = 1 .. 6, see
+/// [`crate::joints`]), runtime-sized otherwise.
+#[derive(Debug)]
 enum Engine {
     Runtime(Box<Workspace>),
-    Joints1(Box<FixedCore<2, 1, 8>>),
-    Joints2(Box<FixedCore<4, 2, 16>>),
-    Joints3(Box<FixedCore<6, 3, 24>>),
+    Fixed(Box<dyn FixedEngine>),
+}
+
+impl Clone for Engine {
+    fn clone(&self) -> Self {
+        match self {
+            Engine::Runtime(ws) => Engine::Runtime(ws.clone()),
+            Engine::Fixed(core) => Engine::Fixed(core.boxed_clone()),
+        }
+    }
+}
+
+impl Engine {
+    fn new(nx: usize, nu: usize, horizon: usize) -> Self {
+        let runtime = || Engine::Runtime(Box::new(Workspace::new(nx, nu, horizon)));
+        crate::with_joint_count!(
+            nu,
+            |N, S, NP| if nx == S {
+                // Slots per stage: 2 nu input bounds, 3 nx state rows.
+                Engine::Fixed(Box::new(FixedCore::<S, N, { 2 * N + 3 * S }>::new(
+                    horizon,
+                )))
+            } else {
+                runtime()
+            },
+            otherwise runtime()
+        )
+    }
+}
+
+/// A compile-time-sized core behind one interface (one virtual call per
+/// solve), so that its sizes come from the joint-count table.
+trait FixedEngine: std::fmt::Debug + Send + Sync {
+    fn run(
+        &mut self,
+        qp: &OcpQp,
+        set: &RiccatiSettings,
+        warm: bool,
+        sol: &mut QpSolution,
+    ) -> (QpStatus, RiccatiInfo);
+    fn save_multipliers(&self, out: &mut Vec<f64>);
+    fn restore_multipliers(&mut self, data: &[f64]) -> bool;
+    fn boxed_clone(&self) -> Box<dyn FixedEngine>;
+}
+
+impl<const NX: usize, const NU: usize, const M: usize> FixedEngine for FixedCore<NX, NU, M> {
+    fn run(
+        &mut self,
+        qp: &OcpQp,
+        set: &RiccatiSettings,
+        warm: bool,
+        sol: &mut QpSolution,
+    ) -> (QpStatus, RiccatiInfo) {
+        run_fixed(self, qp, set, warm, sol)
+    }
+    fn save_multipliers(&self, out: &mut Vec<f64>) {
+        FixedCore::save_multipliers(self, out);
+    }
+    fn restore_multipliers(&mut self, data: &[f64]) -> bool {
+        FixedCore::restore_multipliers(self, data)
+    }
+    fn boxed_clone(&self) -> Box<dyn FixedEngine> {
+        Box::new(self.clone())
+    }
 }
 
 impl RiccatiSolver {
@@ -313,12 +375,7 @@ impl RiccatiSolver {
             info: RiccatiInfo::default(),
             total_regularised: 0,
             warm_next: false,
-            engine: match (nx, nu) {
-                (2, 1) => Engine::Joints1(Box::new(FixedCore::new(horizon))),
-                (4, 2) => Engine::Joints2(Box::new(FixedCore::new(horizon))),
-                (6, 3) => Engine::Joints3(Box::new(FixedCore::new(horizon))),
-                _ => Engine::Runtime(Box::new(Workspace::new(nx, nu, horizon))),
-            },
+            engine: Engine::new(nx, nu, horizon),
         }
     }
 
@@ -357,9 +414,7 @@ impl RiccatiSolver {
                     core.info,
                 )
             }
-            Engine::Joints1(core) => run_fixed(core, qp, set, self.warm_next, sol),
-            Engine::Joints2(core) => run_fixed(core, qp, set, self.warm_next, sol),
-            Engine::Joints3(core) => run_fixed(core, qp, set, self.warm_next, sol),
+            Engine::Fixed(core) => core.run(qp, set, self.warm_next, sol),
         };
         self.info = info;
         self.total_regularised += self.info.regularised_pivots as u64;
@@ -402,9 +457,7 @@ impl QpSolver for RiccatiSolver {
                 out.extend_from_slice(&ws.pi);
                 out.extend_from_slice(&ws.lam);
             }
-            Engine::Joints1(core) => core.save_multipliers(&mut out),
-            Engine::Joints2(core) => core.save_multipliers(&mut out),
-            Engine::Joints3(core) => core.save_multipliers(&mut out),
+            Engine::Fixed(core) => core.save_multipliers(&mut out),
         }
         out
     }
@@ -425,9 +478,7 @@ impl QpSolver for RiccatiSolver {
                             false
                         }
                     }
-                    Engine::Joints1(core) => core.restore_multipliers(data),
-                    Engine::Joints2(core) => core.restore_multipliers(data),
-                    Engine::Joints3(core) => core.restore_multipliers(data),
+                    Engine::Fixed(core) => core.restore_multipliers(data),
                 };
                 if ok {
                     self.warm_next = *warm == 1.0;
