@@ -8,13 +8,11 @@ use eigenmpc::mechanics::MechanicalSystem;
 use eigenmpc::model_file::RobotFile;
 use serde_json::Value;
 use std::path::PathBuf;
-use std::process::Command;
+
+mod common;
 
 fn run(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_eigenmpc"))
-        .args(args)
-        .output()
-        .expect("run eigenmpc");
+    let out = common::eigenmpc(args);
     (
         out.status.code().unwrap_or(-1),
         String::from_utf8_lossy(&out.stdout).into_owned(),

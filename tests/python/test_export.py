@@ -1,4 +1,4 @@
-"""`eigenmpc export` of robot files of 1, 2, 4 and 6 joints: the pair
+"""`eigenmpc export` of robot files of 1, 2, 4, 5 and 6 joints: the pair
 validates in fmpy and closes the loop under fmpy into the 5 % band; the SSP
 runs in fmpy's SSP master."""
 
@@ -23,6 +23,7 @@ ROBOTS = {
     "single": ("robots/examples/single-pendulum.yml", "Single", 2.0, 15.0, 1.0),
     "lab-A0": ("robots/lab-double-pendulum-A0.yml", "LabA0", 2.0, 30.0, 0.5),
     "four": ("robots/examples/four-link-rigid.yml", "FourLink", 1.0, 15.0, 2.0),
+    "five": ("robots/examples/five-link-point-masses.yml", "FiveLink", 2.0, 30.0, 1.0),
     "six": ("robots/examples/six-link-rigid.yml", "SixLink", 1.0, 15.0, 2.0),
 }
 
