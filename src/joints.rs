@@ -4,11 +4,11 @@
 //! `S = 2 N` entries ([`state_size`]) and the identification
 //! `NP = base_parameter_count(N)` base parameters. Stable Rust cannot compute
 //! `2 N` inside a const generic, so code generic over the chain takes `N`,
-//! `S` and `NP` as three parameters; [`with_joint_count!`] binds all three,
+//! `S` and `NP` as three parameters; [`crate::with_joint_count!`] binds all three,
 //! computed, for a count known only at run time (a robot file, a C config,
 //! an FMU's resources).
 //!
-//! **Adding a joint count is one number** in [`joint_count_table!`]: every
+//! **Adding a joint count is one number** in [`crate::joint_count_table!`]: every
 //! dispatch (the CLI, the C API, the FMUs, the demo, the robot-file limit)
 //! follows from it.
 

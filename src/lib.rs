@@ -25,8 +25,10 @@ pub mod identify;
 pub mod integrate;
 pub mod joints;
 pub mod mechanics;
+#[cfg(feature = "files")]
 pub mod model_file;
 pub mod modes;
 pub mod mpc;
 pub mod qp;
+#[cfg(feature = "tooling")]
 pub mod robustness;

@@ -7,10 +7,11 @@
 //! spec) and the instance agree, GUID included. No compiler on the user's
 //! machine: exporting a robot writes files, it builds nothing.
 
+use crate::controller::ControllerFmu;
 use crate::controller::settings::Settings;
-use crate::controller::{ControllerFmu, ControllerProduct};
+use crate::plant::PlantFmu;
 use crate::plant::settings::PlantSettings;
-use crate::plant::{PlantFmu, PlantProduct};
+pub use crate::products::{BINARY_NAME, Exported};
 use crate::{controller, plant};
 use eigenmpc::joints;
 use fmi2_slave::{Context, Model, ModelDescription, ModelError, Values};
@@ -20,10 +21,6 @@ use std::path::Path;
 
 /// The spec's file name inside `resources/`.
 pub const SPEC_FILE: &str = "eigenmpc-export.json";
-
-/// `modelIdentifier` of the description an exported binary shows without
-/// its resources (documentation only: such an instance is refused).
-pub const BINARY_NAME: &str = "EigenMPCRobot";
 
 /// Which model an exported FMU is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -50,33 +47,6 @@ pub struct ExportSpec {
     /// Start values by FMU variable name (`m[1]`, `E_ref`, ...), each
     /// checked as `fmi2Set*` would check it.
     pub start_values: BTreeMap<String, f64>,
-}
-
-/// The product behind every exported FMU: its defaults are the library's
-/// (the spec's start values replace them before anything runs).
-pub struct Exported;
-
-impl<const N: usize> ControllerProduct<N> for Exported {
-    const MODEL_NAME: &'static str = BINARY_NAME;
-    const DESCRIPTION: &'static str = "EigenMPC controller of an exported robot";
-    const E_REF: f64 = 1.0;
-    const EIGENVECTOR: [f64; N] = unit_first::<N>();
-    const CHART: [[f64; controller::settings::CHART_COEFFICIENTS]; N] =
-        [[0.0; controller::settings::CHART_COEFFICIENTS]; N];
-}
-
-impl<const N: usize> PlantProduct<N> for Exported {
-    const MODEL_NAME: &'static str = BINARY_NAME;
-    const DESCRIPTION: &'static str = "an exported robot as a plant";
-}
-
-/// `(1, 0, ..., 0)`: a nonzero placeholder eigenvector.
-const fn unit_first<const N: usize>() -> [f64; N] {
-    let mut v = [0.0; N];
-    if N > 0 {
-        v[0] = 1.0;
-    }
-    v
 }
 
 impl ExportSpec {

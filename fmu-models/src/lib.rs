@@ -21,6 +21,7 @@
 pub mod chain;
 pub mod controller;
 pub mod enums;
+#[cfg(feature = "export")]
 pub mod exported;
 pub mod plant;
 pub mod products;

@@ -4,7 +4,6 @@
 
 use crate::controller::settings::{CHART_COEFFICIENTS, Settings};
 use crate::controller::{ControllerFmu, ControllerProduct};
-use crate::exported::Exported;
 use crate::plant::{PlantFmu, PlantProduct};
 use eigenmpc::mpc::Variant;
 use fmi2_slave::table::RowDoc;
@@ -111,6 +110,37 @@ pub const DEFAULT_CHART_3_14J: [[f64; CHART_COEFFICIENTS]; 3] = [
         -4.416555319818698,
     ],
 ];
+
+/// `modelIdentifier` of [`Exported`]'s description without a spec
+/// (documentation only: an exported robot's FMU is named by its spec).
+pub const BINARY_NAME: &str = "EigenMPCRobot";
+
+/// The product behind every exported FMU and every joint count without a
+/// shipped product: the library's defaults (an exported robot's spec, or
+/// the C API's named values, replace them before anything runs).
+pub struct Exported;
+
+impl<const N: usize> ControllerProduct<N> for Exported {
+    const MODEL_NAME: &'static str = BINARY_NAME;
+    const DESCRIPTION: &'static str = "EigenMPC controller of an exported robot";
+    const E_REF: f64 = 1.0;
+    const EIGENVECTOR: [f64; N] = unit_first::<N>();
+    const CHART: [[f64; CHART_COEFFICIENTS]; N] = [[0.0; CHART_COEFFICIENTS]; N];
+}
+
+impl<const N: usize> PlantProduct<N> for Exported {
+    const MODEL_NAME: &'static str = BINARY_NAME;
+    const DESCRIPTION: &'static str = "an exported robot as a plant";
+}
+
+/// `(1, 0, ..., 0)`: a nonzero placeholder eigenvector.
+const fn unit_first<const N: usize>() -> [f64; N] {
+    let mut v = [0.0; N];
+    if N > 0 {
+        v[0] = 1.0;
+    }
+    v
+}
 
 impl ControllerProduct<2> for EigenMpc2 {
     const MODEL_NAME: &'static str = "EigenMPC";

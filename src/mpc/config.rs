@@ -126,6 +126,13 @@ impl MpcConfig {
         if self.horizon == 0 || self.horizon > MAX_HORIZON {
             return bad("horizon", self.horizon as f64, "must be in 1..=1000");
         }
+        if self.qp.available().is_err() {
+            return bad(
+                "qp_solver",
+                0.0,
+                "clarabel is not in this build (the core's feature `clarabel`): use riccati",
+            );
+        }
         if !(self.dt.is_finite() && self.dt > 0.0) {
             return bad("dt", self.dt, "must be finite and > 0");
         }

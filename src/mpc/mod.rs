@@ -17,6 +17,7 @@
 //! used by default for the very first sample. Everything is sized at
 //! creation; the per-sample path does not allocate.
 
+#[cfg(feature = "tooling")]
 pub mod closed_loop;
 mod config;
 pub mod cost;

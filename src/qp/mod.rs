@@ -17,15 +17,20 @@
 //! Every matrix is allocated once by [`OcpQp::new`] and overwritten in place
 //! at each sample, so the real-time loop does not allocate.
 
+#[cfg(feature = "clarabel")]
 pub mod clarabel;
 
 use nalgebra::{DMatrix, DVector};
 
+#[cfg(feature = "tooling")]
 pub mod kkt;
+#[cfg(feature = "tooling")]
 pub mod record;
 pub mod riccati;
+#[cfg(feature = "tooling")]
 pub mod synthetic;
 
+#[cfg(feature = "tooling")]
 pub use kkt::{KktResiduals, kkt_residuals};
 pub use riccati::{RiccatiInfo, RiccatiSettings, RiccatiSolver};
 
@@ -195,15 +200,38 @@ impl QpBackend {
         }
     }
 
+    /// Whether this build has the backend (clarabel is the core's feature
+    /// `clarabel`), or why not.
+    pub fn available(self) -> Result<(), String> {
+        match self {
+            QpBackend::Clarabel if !cfg!(feature = "clarabel") => Err(
+                "qp = clarabel: this library was built without clarabel (the core's feature \
+                 `clarabel`); use riccati"
+                    .into(),
+            ),
+            _ => Ok(()),
+        }
+    }
+
     /// Creates the solver for QPs with `nx` states, `nu` controls and
     /// horizon `horizon` (allocates; call once at set-up).
     pub fn create(self, nx: usize, nu: usize, horizon: usize) -> Box<dyn QpSolver + Send> {
         match self {
+            #[cfg(feature = "clarabel")]
             QpBackend::Clarabel => Box::new(self::clarabel::ClarabelQpSolver::new(
                 nx,
                 nu,
                 horizon,
                 self::clarabel::rti_settings(),
+            )),
+            // Unreachable through a validated config (`available` refuses
+            // it); the Riccati solver rather than a panic otherwise.
+            #[cfg(not(feature = "clarabel"))]
+            QpBackend::Clarabel => Box::new(RiccatiSolver::new(
+                nx,
+                nu,
+                horizon,
+                RiccatiSettings::default(),
             )),
             QpBackend::Riccati => Box::new(RiccatiSolver::new(
                 nx,
