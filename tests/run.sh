@@ -43,6 +43,9 @@ demo_reaches_band() {
 demo_reaches_band --model robots/lab-double-pendulum-A0.yml --energy 2 --tau-max 0.5 \
     --duration 30 --out-dir target/demo-ci-A0
 demo_reaches_band --links 3 --out-dir target/demo-ci-3
+# A robot file of 4 links: no shipped pair, the demo exports one (eigenmpc export).
+demo_reaches_band --model robots/examples/four-link-rigid.yml --energy 1 --duration 15 \
+    --out-dir target/demo-ci-4link
 if bash demo/run.sh --no-build --links 4 --out-dir target/demo-ci-4 2>/dev/null; then
     echo "demo --links 4 should be refused" >&2
     exit 1

@@ -2,10 +2,12 @@
 //! closed loop (summary text, CSV, plots), shared by `eigenmpc simulate` and
 //! the FMU demo, those of its online adaptation (`simulate --adapt`), the
 //! robustness sweep (`eigenmpc robustness`) and parameter sweeps
-//! (`eigenmpc sweep`). The core crate and the FMU libraries stay free of the CLI,
+//! (`eigenmpc sweep`), and the export of a robot as an FMU pair
+//! (`eigenmpc export`, the demo). The core crate and the FMU libraries stay free of the CLI,
 //! plotting and progress-bar crates.
 
 pub mod adaptation;
+pub mod export;
 pub mod paper;
 pub mod report;
 pub mod robustness;

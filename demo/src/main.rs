@@ -20,6 +20,7 @@ use eigenmpc::model_file::RobotFile;
 use eigenmpc::modes::Family;
 use eigenmpc::mpc::ControlStatus;
 use eigenmpc::mpc::closed_loop::{Sample, mode_and_chart, summarise};
+use eigenmpc_cli::export;
 use eigenmpc_cli::report::{PlotInfo, plot_run, summary_text, write_csv};
 use eigenmpc_fmu_models::controller::start_values::model_start_values;
 use fmi::fmi2::Fmi2Res;
@@ -55,7 +56,8 @@ struct Args {
     #[arg(long, allow_hyphen_values = true)]
     q0: Option<String>,
     /// Number of links: 2 (EigenMPC.fmu, DoublePendulum.fmu) or 3
-    /// (EigenMPC3.fmu, TriplePendulum.fmu); default 2, or the model file's.
+    /// (EigenMPC3.fmu, TriplePendulum.fmu); default 2, or the model file's
+    /// (a file of 1, 4, 5 or 6 links is exported into OUT_DIR/fmu first).
     #[arg(long)]
     links: Option<usize>,
     /// Robot parameter file (JSON or YAML, see robots/README.md) for the
@@ -74,11 +76,11 @@ struct Slave {
     // before the import removes the extracted library.
     instance: InstanceCS,
     import: Fmi2Import,
-    name: &'static str,
+    name: String,
 }
 
 impl Slave {
-    fn load(path: &Path, name: &'static str) -> Result<Self> {
+    fn load(path: &Path, name: &str) -> Result<Self> {
         let import: Fmi2Import =
             fmi::import::from_path(path).with_context(|| format!("loading {}", path.display()))?;
         let instance = import
@@ -87,7 +89,7 @@ impl Slave {
         Ok(Self {
             instance,
             import,
-            name,
+            name: name.to_string(),
         })
     }
 
@@ -171,11 +173,31 @@ fn run(args: &Args) -> Result<()> {
         (None, Some(f)) => f.links(),
         (None, None) => 2,
     };
-    match links {
-        2 => co_simulate::<2, 4>(args, file.as_ref(), ("EigenMPC", "DoublePendulum")),
-        3 => co_simulate::<3, 6>(args, file.as_ref(), ("EigenMPC3", "TriplePendulum")),
-        n => bail!("--links {n}: the FMUs are built for 2 or 3 links"),
-    }
+    // The shipped pairs for 2 and 3 links; any other count of the table is
+    // a robot file exported as a pair (no shipped FMU to fall back on).
+    let pair = match (links, &file) {
+        (2, _) => Pair::Shipped("EigenMPC", "DoublePendulum"),
+        (3, _) => Pair::Shipped("EigenMPC3", "TriplePendulum"),
+        (n, None) => bail!(
+            "--links {n}: the shipped FMUs have 2 or 3 links; give a robot file of {n} links \
+             (--model FILE), which the demo exports as an FMU pair"
+        ),
+        (_, Some(_)) => Pair::Exported,
+    };
+    eigenmpc::with_joint_count!(
+        links,
+        |N, S, NP| co_simulate::<N, S>(args, file.as_ref(), pair),
+        otherwise bail!("{}", eigenmpc::joints::unsupported(links))
+    )
+}
+
+/// The controller and plant FMUs of a run.
+#[derive(Clone, Copy)]
+enum Pair {
+    /// A shipped pair in `--fmu-dir`: controller and plant `modelIdentifier`.
+    Shipped(&'static str, &'static str),
+    /// The robot file exported (`eigenmpc export`) into `OUT_DIR/fmu`.
+    Exported,
 }
 
 /// Sets every Real start value of `values` (the model rows are all Real).
@@ -193,7 +215,7 @@ fn set_values(slave: &mut Slave, values: &[(String, Value)]) -> Result<()> {
 fn co_simulate<const N: usize, const NX: usize>(
     args: &Args,
     file: Option<&RobotFile>,
-    (controller_name, plant_name): (&'static str, &'static str),
+    pair: Pair,
 ) -> Result<()> {
     let q0: Vec<f64> = match &args.q0 {
         Some(text) => text
@@ -237,11 +259,41 @@ fn co_simulate<const N: usize, const NX: usize>(
         .with_context(|| format!("in-phase eigenmode at {} J", args.energy))?;
     let model_values = model_start_values(&params).map_err(|e| anyhow!("model: {e}"))?;
 
-    let mut controller = Slave::load(
-        &args.fmu_dir.join(format!("{controller_name}.fmu")),
-        controller_name,
-    )?;
-    let mut plant = Slave::load(&args.fmu_dir.join(format!("{plant_name}.fmu")), plant_name)?;
+    let ((controller_name, controller_path), (plant_name, plant_path)) = match pair {
+        Pair::Shipped(c, p) => (
+            (c.to_string(), args.fmu_dir.join(format!("{c}.fmu"))),
+            (p.to_string(), args.fmu_dir.join(format!("{p}.fmu"))),
+        ),
+        Pair::Exported => {
+            let file = file.context("an exported pair needs a robot file")?;
+            let stem = file
+                .path()
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            let binary = export::robot_binary_path(&args.fmu_dir);
+            let source = file.path().display().to_string();
+            let options = export::ExportOptions {
+                name: &export::camel_case(&stem),
+                energy: args.energy,
+                family: Family::InPhase,
+                tau_max,
+                chart_degree: 9,
+                source: &source,
+                binary: &export::find_binary(Some(&binary))?,
+            };
+            let written = export::export::<N, NX>(&model, &options, &args.out_dir.join("fmu"))?;
+            println!(
+                "exported {} as {} and {}",
+                source,
+                written.controller.1.display(),
+                written.plant.1.display()
+            );
+            (written.controller, written.plant)
+        }
+    };
+    let mut controller = Slave::load(&controller_path, &controller_name)?;
+    let mut plant = Slave::load(&plant_path, &plant_name)?;
 
     let joints = |base: &'static str| (1..=N).map(move |j| format!("{base}[{j}]"));
     let state_names: Vec<String> = joints("q").chain(joints("qd")).collect();
@@ -333,12 +385,21 @@ fn co_simulate<const N: usize, const NX: usize>(
         args.energy,
         q0_text.join(", ")
     );
-    println!(
-        "chart family computed by the controller FMU: {:.4} .. {:.4} J in {:.0} ms",
-        range[0],
-        range[1],
-        created * 1e3
-    );
+    if range[1] > range[0] {
+        println!(
+            "chart family computed by the controller FMU: {:.4} .. {:.4} J in {:.0} ms",
+            range[0],
+            range[1],
+            created * 1e3
+        );
+    } else {
+        // An exported controller starts from its chart at E_ref
+        // (chart_source = parameters): no family to compute.
+        println!(
+            "chart at E_ref from the exported start values; controller initialized in {:.0} ms",
+            created * 1e3
+        );
+    }
     print!("{}", summary_text(&summary));
     println!("co-simulation wall time:         {wall:.2} s");
     std::fs::create_dir_all(&args.out_dir)

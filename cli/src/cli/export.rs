@@ -1,20 +1,15 @@
 //! `eigenmpc export`: a user's robot as a controller FMU, a plant FMU and
-//! the SSP that couples them, without compiling anything. Both FMUs carry
-//! the one prebuilt binary of `eigenmpc-robot-fmu` and tell it what they
-//! are in `resources/eigenmpc-export.json`; each is loaded and stepped
-//! before the command returns.
+//! the SSP that couples them ([`eigenmpc_cli::export`]).
 
 use super::ModelArgs;
 use anyhow::{Context, bail};
 use clap::Args;
-use eigenmpc::mechanics::MechanicalSystem;
 use eigenmpc::model_file::RobotFile;
-use eigenmpc::modes::{Family, linear_modes};
-use eigenmpc::mpc::closed_loop::mode_and_chart;
-use eigenmpc_fmu_models::exported::{ExportSpec, RobotExport, SPEC_FILE};
-use fmu_build::archive::{self, PLATFORM, ROBOT_LIBRARY};
-use fmu_build::ssp::{self, SspSpec};
-use std::path::{Path, PathBuf};
+use eigenmpc::modes::Family;
+use eigenmpc_cli::export::{
+    ExportOptions, camel_case, check_name, default_energy, export, find_binary,
+};
+use std::path::PathBuf;
 
 /// Arguments of `eigenmpc export`.
 #[derive(Args, Debug)]
@@ -48,62 +43,6 @@ pub struct ExportArgs {
     binary: Option<PathBuf>,
 }
 
-/// `lab-double-pendulum-A0` -> `LabDoublePendulumA0`.
-fn camel_case(stem: &str) -> String {
-    stem.split(|c: char| !c.is_ascii_alphanumeric())
-        .filter(|w| !w.is_empty())
-        .map(|w| {
-            let mut chars = w.chars();
-            chars
-                .next()
-                .map(|c| c.to_ascii_uppercase().to_string() + chars.as_str())
-                .unwrap_or_default()
-        })
-        .collect()
-}
-
-/// A name usable as `modelIdentifier` (C identifier, file name).
-fn check_name(name: &str) -> anyhow::Result<()> {
-    let ok = name.chars().next().is_some_and(|c| c.is_ascii_alphabetic())
-        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
-    if !ok {
-        bail!(
-            "--name '{name}': an FMU name starts with a letter and has only letters, digits and _"
-        );
-    }
-    Ok(())
-}
-
-/// The exported robots' binary: `--binary`, else `fmu-build`'s stripped
-/// copy (`target/fmu/robot/linux64/`) or cargo's build next to this
-/// executable.
-fn find_binary(given: Option<&Path>) -> anyhow::Result<PathBuf> {
-    if let Some(path) = given {
-        if !path.is_file() {
-            bail!("--binary {}: no such file", path.display());
-        }
-        return Ok(path.to_path_buf());
-    }
-    let exe = std::env::current_exe().context("locating the eigenmpc executable")?;
-    let dir = exe.parent().context("the executable's folder")?;
-    let candidates = [
-        archive::robot_binary_path(&dir.join("../fmu")),
-        dir.join(ROBOT_LIBRARY),
-        dir.join("../release").join(ROBOT_LIBRARY),
-    ];
-    candidates
-        .iter()
-        .find(|p| p.is_file())
-        .cloned()
-        .with_context(|| {
-            format!(
-                "no exported-robot FMU binary ({ROBOT_LIBRARY}) next to {}: build it with \
-                 `cargo run -p fmu-build` or give --binary FILE",
-                exe.display()
-            )
-        })
-}
-
 /// Runs the subcommand for the file's joint count.
 pub fn run(args: &ExportArgs) -> anyhow::Result<()> {
     let model_args = ModelArgs::for_file(&args.model);
@@ -133,18 +72,12 @@ fn run_for<const N: usize, const S: usize>(
         ),
     };
     check_name(&name)?;
-    let binary_path = find_binary(args.binary.as_deref())?;
-    let binary = std::fs::read(&binary_path)
-        .with_context(|| format!("reading {}", binary_path.display()))?;
+    let binary = find_binary(args.binary.as_deref())?;
     let system = &robot.system;
     let energy = match args.energy {
         Some(e) if e.is_finite() && e > 0.0 => e,
         Some(e) => bail!("--energy {e}: must be finite and > 0"),
-        None => {
-            let mut upright = system.equilibrium();
-            upright[0] += std::f64::consts::PI;
-            0.1 * system.potential(&upright)
-        }
+        None => default_energy(system),
     };
     let limits = file.torque_limits();
     let tau_max = match (args.tau_max, &limits) {
@@ -157,203 +90,30 @@ fn run_for<const N: usize, const S: usize>(
         (None, Some(tl)) => tl.iter().copied().fold(f64::INFINITY, f64::min),
         (None, None) => 1.0,
     };
-    let eigenvector = linear_modes(system)?[family.index()].eigenvector;
-    let (_, chart) = mode_and_chart::<_, N, S>(system, family.index(), energy, args.chart_degree)
-        .with_context(|| format!("{family} eigenmode at {energy} J"))?;
     let source = args
         .model
         .file_name()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let specs = RobotExport {
-        name: &name,
-        model: system.params(),
-        e_ref: energy,
-        eigenvector: &std::array::from_fn(|j| eigenvector[j]),
-        chart: &chart.coefficients,
-        tau_max,
-        source: &source,
-    }
-    .specs()
-    .map_err(anyhow::Error::msg)?;
     super::prepare_out_dir(&args.out)?;
-    let mut written = vec![];
-    for spec in &specs {
-        let path = write_fmu(&args.out, spec, &binary)?;
-        validate(&path, spec).with_context(|| format!("validating {}", path.display()))?;
-        written.push(path);
-    }
-    let [controller, plant] = &specs;
-    let ssp_spec = SspSpec {
+    let options = ExportOptions {
         name: &name,
-        controller: &controller.model_name,
-        plant: &plant.model_name,
-        joints: N,
+        energy,
+        family,
+        tau_max,
+        chart_degree: args.chart_degree,
+        source: &source,
+        binary: &binary,
     };
-    written.push(ssp::package(&args.out, &ssp_spec)?);
+    let written = export::<N, S>(system, &options, &args.out)?;
     println!(
         "{} ({N} joints): {family} eigenmode at E_ref = {energy:.6} J, chart degree {}, \
          |tau| <= {tau_max} N m",
         args.model.display(),
         args.chart_degree
     );
-    for path in written {
+    for path in [&written.controller.1, &written.plant.1, &written.ssp] {
         println!("wrote {}", path.display());
     }
     Ok(())
-}
-
-/// Writes `<out>/<model_name>.fmu` of `spec`.
-fn write_fmu(out: &Path, spec: &ExportSpec, binary: &[u8]) -> anyhow::Result<PathBuf> {
-    let description = spec.description().map_err(anyhow::Error::msg)?;
-    let xml = fmi2_slave::xml::model_description_xml(&description);
-    let intro = format!(
-        "<p>{}</p><p>Exported by <code>eigenmpc export</code>: the robot's parameters are this \
-         FMU's start values; <code>resources/{SPEC_FILE}</code> tells the binary what it is.</p>",
-        fmi2_slave::xml::escape(&spec.description)
-    );
-    let html = fmi2_slave::xml::documentation_html(&description, &intro);
-    let json = serde_json::to_string_pretty(spec)?;
-    let path = out.join(format!("{}.fmu", spec.model_name));
-    archive::write_fmu(
-        &path,
-        &spec.model_name,
-        &xml,
-        binary,
-        &html,
-        &[(SPEC_FILE, json.as_bytes())],
-    )?;
-    Ok(path)
-}
-
-/// Loads the archive as a host does (unpacked into a temporary folder, the
-/// binary opened, `fmuResourceLocation` a `file:` URI) and runs one second
-/// of co-simulation from the start values.
-fn validate(fmu: &Path, spec: &ExportSpec) -> anyhow::Result<()> {
-    use fmi2_slave::ffi;
-    let dir = std::env::temp_dir().join(format!(
-        "eigenmpc-export-{}-{}",
-        std::process::id(),
-        spec.model_name
-    ));
-    std::fs::create_dir_all(&dir)?;
-    let result = (|| -> anyhow::Result<()> {
-        let mut zip = zip::ZipArchive::new(std::fs::File::open(fmu)?)?;
-        zip.extract(&dir)?;
-        let library = dir
-            .join("binaries")
-            .join(PLATFORM)
-            .join(format!("{}.so", spec.model_name));
-        let xml = std::fs::read_to_string(dir.join("modelDescription.xml"))?;
-        let guid = xml
-            .split("guid=\"")
-            .nth(1)
-            .and_then(|r| r.split('"').next())
-            .context("no guid in modelDescription.xml")?;
-        // SAFETY: the binary is ours (eigenmpc-robot-fmu): loading runs no
-        // foreign initialisers.
-        let lib = unsafe { ffi::Fmi2Binding::new(&library) }
-            .with_context(|| format!("loading {}", library.display()))?;
-        let log = fmi2_slave::testing::LogCapture::new();
-        let callbacks = log.callbacks();
-        let c_name = std::ffi::CString::new(spec.model_name.as_str())?;
-        let c_guid = std::ffi::CString::new(guid)?;
-        let uri = std::ffi::CString::new(file_uri(&dir.join("resources")))?;
-        // The binding's symbols are fn pointers: copy each out.
-        macro_rules! sym {
-            ($name:ident) => {
-                *lib.$name
-                    .as_ref()
-                    .map_err(|e| anyhow::anyhow!("{}: {e}", stringify!($name)))?
-            };
-        }
-        let ok = |status: ffi::fmi2Status, call: &str| -> anyhow::Result<()> {
-            if status != ffi::fmi2Status_fmi2OK {
-                let lines: Vec<String> = log.lines().iter().map(|l| l.message.clone()).collect();
-                bail!("{call} returned {status}: {}", lines.join("; "));
-            }
-            Ok(())
-        };
-        // SAFETY: the FMI 2.0 calling sequence with valid arguments; the
-        // callbacks and strings outlive the instance.
-        unsafe {
-            let instance = sym!(fmi2Instantiate)(
-                c_name.as_ptr(),
-                ffi::fmi2Type_fmi2CoSimulation,
-                c_guid.as_ptr(),
-                uri.as_ptr(),
-                &callbacks,
-                0,
-                0,
-            );
-            if instance.is_null() {
-                let lines: Vec<String> = log.lines().iter().map(|l| l.message.clone()).collect();
-                bail!("fmi2Instantiate failed: {}", lines.join("; "));
-            }
-            let dt = 0.025;
-            let run = (|| -> anyhow::Result<()> {
-                ok(
-                    sym!(fmi2SetupExperiment)(instance, 0, 0.0, 0.0, 0, 0.0),
-                    "fmi2SetupExperiment",
-                )?;
-                ok(
-                    sym!(fmi2EnterInitializationMode)(instance),
-                    "fmi2EnterInitializationMode",
-                )?;
-                ok(
-                    sym!(fmi2ExitInitializationMode)(instance),
-                    "fmi2ExitInitializationMode",
-                )?;
-                let step = sym!(fmi2DoStep);
-                for k in 0..40 {
-                    ok(step(instance, k as f64 * dt, dt, 1), "fmi2DoStep")?;
-                }
-                ok(sym!(fmi2Terminate)(instance), "fmi2Terminate")
-            })();
-            sym!(fmi2FreeInstance)(instance);
-            run
-        }
-    })();
-    std::fs::remove_dir_all(&dir).ok();
-    result
-}
-
-/// `file:///...` of a folder, percent-encoding what a URI path cannot hold.
-fn file_uri(path: &Path) -> String {
-    let mut uri = String::from("file://");
-    for b in path.display().to_string().bytes() {
-        if b.is_ascii_alphanumeric() || b"/-_.~".contains(&b) {
-            uri.push(b as char);
-        } else {
-            uri.push_str(&format!("%{b:02X}"));
-        }
-    }
-    uri
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn names_from_file_names() {
-        assert_eq!(camel_case("lab-double-pendulum-A0"), "LabDoublePendulumA0");
-        assert_eq!(camel_case("six_link rigid"), "SixLinkRigid");
-        assert!(check_name("SixLink_2").is_ok());
-        assert!(check_name("2link").is_err());
-        assert!(check_name("a-b").is_err());
-        assert!(check_name("").is_err());
-    }
-
-    #[test]
-    fn uris_of_folders() {
-        assert_eq!(
-            file_uri(Path::new("/tmp/a b/resources")),
-            "file:///tmp/a%20b/resources"
-        );
-        assert_eq!(
-            fmi2_slave::resources::resource_dir(&file_uri(Path::new("/tmp/a b%/r"))),
-            Some(PathBuf::from("/tmp/a b%/r"))
-        );
-    }
 }
