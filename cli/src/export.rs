@@ -63,7 +63,10 @@ pub fn export<const N: usize, const S: usize>(
         .with_context(|| format!("reading {}", options.binary.display()))?;
     let family = options.family;
     let energy = options.energy;
-    let eigenvector = linear_modes(system)?[family.index()].eigenvector;
+    let eigenvector = linear_modes(system)?
+        .get(family.index())
+        .with_context(|| format!("a {N}-joint chain has no {family} family"))?
+        .eigenvector;
     let (_, chart) =
         mode_and_chart::<_, N, S>(system, family.index(), energy, options.chart_degree)
             .with_context(|| format!("{family} eigenmode at {energy} J"))?;

@@ -189,6 +189,37 @@ fn a_wrong_joint_count_is_a_clear_error() {
     assert_eq!(code, 1);
     assert!(stderr.contains("at most 6 links"), "{stderr}");
 
+    // One joint has one mode: the anti-phase family is an error, not a panic.
+    let single = example("single-pendulum.yml");
+    for command in [
+        &[
+            "modes",
+            "--model",
+            &single,
+            "--energies",
+            "1",
+            "--family",
+            "anti-phase",
+        ][..],
+        &[
+            "simulate",
+            "--model",
+            &single,
+            "--variant",
+            "straight",
+            "--family",
+            "anti-phase",
+        ],
+    ] {
+        let (code, _, stderr) = run(command);
+        assert_eq!(code, 1, "{command:?}: {stderr}");
+        assert!(
+            stderr.contains("1-joint chain has no anti-phase family"),
+            "{stderr}"
+        );
+        assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
+    }
+
     let four = example("four-link-rigid.yml");
     let (code, _, stderr) = run(&[
         "simulate",

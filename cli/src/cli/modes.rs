@@ -136,7 +136,9 @@ fn run_for<const N: usize, const S: usize>(args: &ModesArgs) -> anyhow::Result<(
     }
     let robot = args.model.robot_of::<N>()?;
     let system = robot.system;
-    let linear = linear_modes(&system)?[family.index()];
+    let linear = *linear_modes(&system)?
+        .get(family.index())
+        .with_context(|| format!("a {N}-joint chain has no {family} family"))?;
     let opts = ContinuationOptions {
         samples: args.samples,
         ..Default::default()

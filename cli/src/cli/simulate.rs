@@ -433,7 +433,10 @@ fn run_simulate_for<const N: usize, const S: usize, const NP: usize>(
     } else {
         let reference = match variant {
             Variant::Straight => Reference::Straight {
-                eigenvector: linear_modes(&model)?[family.index()].eigenvector,
+                eigenvector: linear_modes(&model)?
+                    .get(family.index())
+                    .with_context(|| format!("a {N}-joint chain has no {family} family"))?
+                    .eigenvector,
             },
             chart_variant => Reference::with_chart(
                 chart_variant,
