@@ -32,8 +32,12 @@ fn main() {
             speed_noise: sigma,
             acceleration_noise: a,
         });
-        let mut ctrl = Controller::<_, 2, 4>::new(sys, config, Reference::Curved(chart.clone()))
-            .expect("controller");
+        let mut ctrl = Controller::<_, 2, 4>::new(
+            sys,
+            config,
+            Reference::with_chart(Variant::Curved, chart.clone()),
+        )
+        .expect("controller");
         let mut noise = GaussianNoise::new(1);
         let z0 = SVector::<f64, 4>::new(0.05, 0.05, 0.0, 0.0);
         let trace = run_measured(

@@ -20,9 +20,13 @@ fn closed_loop(solver: Box<dyn QpSolver + Send>) -> Vec<Sample<2, 4>> {
     let (_, chart) =
         mode_and_chart::<_, 2, 4>(&sys, Family::InPhase.index(), 14.0, 9).expect("mode");
     let config = MpcConfig::paper(Variant::Curved);
-    let mut ctrl =
-        Controller::<_, 2, 4>::with_solver(sys, config, Reference::Curved(chart), solver)
-            .expect("controller");
+    let mut ctrl = Controller::<_, 2, 4>::with_solver(
+        sys,
+        config,
+        Reference::with_chart(Variant::Curved, chart),
+        solver,
+    )
+    .expect("controller");
     let z0 = SVector::<f64, 4>::new(0.05, 0.05, 0.0, 0.0);
     run(&mut ctrl, &sys, &z0, 30.0).expect("plant")
 }

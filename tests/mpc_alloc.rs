@@ -5,6 +5,7 @@
 
 use eigenmpc::mechanics::DoublePendulum;
 use eigenmpc::modes::{ChartFamily, FamilyOptions, linear_modes};
+use eigenmpc::mpc::Guide;
 use eigenmpc::mpc::closed_loop::mode_and_chart;
 use eigenmpc::mpc::{Controller, EstimatorConfig, MpcConfig, QpBackend, Reference, Variant};
 use eigenmpc::qp::clarabel::{ClarabelQpSolver, rti_settings};
@@ -64,10 +65,12 @@ fn control_steps_do_not_allocate() {
     let sys = DoublePendulum::default();
     let (_, chart) = mode_and_chart::<_, 2, 4>(&sys, 0, 14.0, 9).unwrap();
     let references = [
-        Reference::Straight {
-            eigenvector: linear_modes(&sys).unwrap()[0].eigenvector,
-        },
-        Reference::Curved(chart),
+        Reference::new(
+            Variant::Straight,
+            Guide::Line(linear_modes(&sys).unwrap()[0].eigenvector),
+        )
+        .unwrap(),
+        Reference::with_chart(Variant::Curved, chart),
     ];
     for reference in references {
         let variant = reference.variant();
@@ -158,7 +161,9 @@ fn control_steps_do_not_allocate() {
         speed_noise: 0.05,
         acceleration_noise: 0.3,
     });
-    let mut ctrl = Controller::<_, 2, 4>::new(sys, config, Reference::Curved(chart)).unwrap();
+    let mut ctrl =
+        Controller::<_, 2, 4>::new(sys, config, Reference::with_chart(Variant::Curved, chart))
+            .unwrap();
     let mut z = SVector::<f64, 4>::new(0.3, 0.2, 0.0, 0.0);
     z = eigenmpc::integrate::rk4_step::<_, 2, 4>(&sys, &z, &ctrl.step(&z).tau, 0.025);
     let before = OURS.load(Ordering::SeqCst) + BACKEND.load(Ordering::SeqCst);

@@ -4,6 +4,7 @@
 
 use eigenmpc::mechanics::{DoublePendulum, MechanicalSystem, Vector};
 use eigenmpc::modes::linear_modes;
+use eigenmpc::mpc::Guide;
 use eigenmpc::mpc::closed_loop::mode_and_chart;
 use eigenmpc::mpc::cost::{CostParams, Reference, residuals, stage_model};
 use eigenmpc::mpc::{ControlStatus, Controller, MpcConfig, MpcError, Variant};
@@ -14,21 +15,20 @@ use nalgebra::{DVector, SVector};
 type Z = SVector<f64, 4>;
 
 fn straight() -> Reference<2> {
-    Reference::Straight {
-        eigenvector: linear_modes(&DoublePendulum::default()).unwrap()[0].eigenvector,
-    }
+    Reference::new(
+        Variant::Straight,
+        Guide::Line(linear_modes(&DoublePendulum::default()).unwrap()[0].eigenvector),
+    )
+    .unwrap()
 }
 
 fn curved() -> Reference<2> {
     let (_, chart) = mode_and_chart::<_, 2, 4>(&DoublePendulum::default(), 0, 14.0, 9).unwrap();
-    Reference::Curved(chart)
+    Reference::with_chart(Variant::Curved, chart)
 }
 
 fn hybrid() -> Reference<2> {
-    match curved() {
-        Reference::Curved(chart) => Reference::Hybrid(chart),
-        _ => unreachable!(),
-    }
+    Reference::with_chart(Variant::Hybrid, curved().chart().unwrap().clone())
 }
 
 /// The three variants with their references; hybrid with a larger alpha
@@ -426,10 +426,11 @@ fn bad_configuration_and_tuning_are_refused() {
         Controller::<_, 2, 4>::new(sys, config, straight()),
         Err(MpcError::InvalidParameter { name: "dt", .. })
     ));
-    let bad_ref = Reference::Straight {
-        eigenvector: Vector::<2>::zeros(),
-    };
-    assert!(Controller::<_, 2, 4>::new(sys, MpcConfig::paper(Variant::Straight), bad_ref).is_err());
+    assert!(Reference::new(Variant::Straight, Guide::Line(Vector::<2>::zeros())).is_err());
+    let mut nan_chart = curved().chart().unwrap().clone();
+    nan_chart.coefficients[0][1] = f64::NAN;
+    let bad_ref = Reference::with_chart(Variant::Curved, nan_chart);
+    assert!(Controller::<_, 2, 4>::new(sys, MpcConfig::paper(Variant::Curved), bad_ref).is_err());
     let mut ctrl =
         Controller::<_, 2, 4>::new(sys, MpcConfig::paper(Variant::Straight), straight()).unwrap();
     assert!(ctrl.set_e_ref(f64::NAN).is_err());
@@ -471,7 +472,9 @@ fn hybrid_closed_loop_reaches_the_mode() {
     let mut config = MpcConfig::paper(Variant::Hybrid);
     config.cost.alpha = 0.01;
     config.cost.beta = 0.9;
-    let mut ctrl = Controller::<_, 2, 4>::new(sys, config, Reference::Hybrid(chart)).unwrap();
+    let mut ctrl =
+        Controller::<_, 2, 4>::new(sys, config, Reference::with_chart(Variant::Hybrid, chart))
+            .unwrap();
     let trace = run(&mut ctrl, &sys, &Z::new(0.05, 0.05, 0.0, 0.0), 30.0).unwrap();
     let s = summarise(&trace, 14.0, Some(&mode.path), 5.0);
     assert!(s.time_to_5_percent.is_some_and(|t| t < 25.0), "{s:?}");

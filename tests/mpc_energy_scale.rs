@@ -4,6 +4,7 @@
 
 use eigenmpc::mechanics::{DoublePendulum, MechanicalSystem, Vector};
 use eigenmpc::modes::linear_modes;
+use eigenmpc::mpc::Guide;
 use eigenmpc::mpc::closed_loop::{Summary, mode_and_chart, run, summarise};
 use eigenmpc::mpc::cost::{CostParams, Reference, residuals};
 use eigenmpc::mpc::{Controller, MpcConfig, MpcError, PAPER_ENERGY_SCALE, Variant};
@@ -15,9 +16,11 @@ type Z = SVector<f64, 4>;
 fn reference(variant: Variant, e_ref: f64) -> Reference<2> {
     let sys = DoublePendulum::default();
     match variant {
-        Variant::Straight => Reference::Straight {
-            eigenvector: linear_modes(&sys).unwrap()[0].eigenvector,
-        },
+        Variant::Straight => Reference::new(
+            Variant::Straight,
+            Guide::Line(linear_modes(&sys).unwrap()[0].eigenvector),
+        )
+        .unwrap(),
         v => Reference::with_chart(v, mode_and_chart::<_, 2, 4>(&sys, 0, e_ref, 9).unwrap().1),
     }
 }
@@ -162,7 +165,9 @@ fn from_rest(e_ref: f64, energy_scale: f64, duration: f64) -> Summary<2> {
     let mut config = MpcConfig::paper(Variant::Curved);
     config.cost.e_ref = e_ref;
     config.cost.energy_scale = energy_scale;
-    let mut ctrl = Controller::<_, 2, 4>::new(sys, config, Reference::Curved(chart)).unwrap();
+    let mut ctrl =
+        Controller::<_, 2, 4>::new(sys, config, Reference::with_chart(Variant::Curved, chart))
+            .unwrap();
     let trace = run(&mut ctrl, &sys, &Z::new(0.05, 0.05, 0.0, 0.0), duration).unwrap();
     let s = summarise(&trace, e_ref, Some(&mode.path), 5.0);
     eprintln!("curved {e_ref} J, E_s = {energy_scale} J: {s:?}");

@@ -26,7 +26,9 @@ fn closed_loop(estimator: Option<EstimatorConfig>, sigma: f64, seconds: f64) -> 
     let (mode, chart) = mode_and_chart::<_, 2, 4>(&sys, 0, 14.0, 9).unwrap();
     let mut config = MpcConfig::paper(Variant::Curved);
     config.estimator = estimator;
-    let mut ctrl = Controller::<_, 2, 4>::new(sys, config, Reference::Curved(chart)).unwrap();
+    let mut ctrl =
+        Controller::<_, 2, 4>::new(sys, config, Reference::with_chart(Variant::Curved, chart))
+            .unwrap();
     let mut noise = GaussianNoise::new(1);
     let z0 = SVector::<f64, 4>::new(0.05, 0.05, 0.0, 0.0);
     let trace = run_measured(
@@ -72,7 +74,9 @@ fn invalid_measurements_and_resets_keep_the_estimate_sane() {
     let (_, chart) = mode_and_chart::<_, 2, 4>(&sys, 0, 14.0, 9).unwrap();
     let mut config = MpcConfig::paper(Variant::Curved);
     config.estimator = Some(estimator());
-    let mut ctrl = Controller::<_, 2, 4>::new(sys, config, Reference::Curved(chart)).unwrap();
+    let mut ctrl =
+        Controller::<_, 2, 4>::new(sys, config, Reference::with_chart(Variant::Curved, chart))
+            .unwrap();
     assert!(ctrl.state_estimate().is_none());
     let z = SVector::<f64, 4>::new(0.3, 0.2, 0.0, 0.0);
     ctrl.step(&z);

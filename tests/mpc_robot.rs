@@ -5,6 +5,7 @@
 use eigenmpc::mechanics::{DoublePendulum, MechanicalSystem, Vector};
 use eigenmpc::model_file::RobotFile;
 use eigenmpc::modes::{Chart, ChartFamily, ContinuationOptions, FamilyOptions, eigenmode_family};
+use eigenmpc::mpc::Guide;
 use eigenmpc::mpc::closed_loop::{
     energy_tail, mode_and_chart, rms_friction_torque, run_tuned, summarise,
 };
@@ -78,11 +79,16 @@ fn friction_compensating_residual_jacobians_match_finite_differences() {
     let sys = robot("lab-double-pendulum-A0.yml");
     let (_, chart) = mode_and_chart::<_, 2, 4>(&sys, 0, 2.0, 9).unwrap();
     let references = [
-        (Reference::Curved(chart), Variant::Curved),
         (
-            Reference::Straight {
-                eigenvector: Vector::<2>::new(0.9, 0.43).normalize(),
-            },
+            Reference::with_chart(Variant::Curved, chart),
+            Variant::Curved,
+        ),
+        (
+            Reference::new(
+                Variant::Straight,
+                Guide::Line(Vector::<2>::new(0.9, 0.43).normalize()),
+            )
+            .unwrap(),
             Variant::Straight,
         ),
     ];
@@ -179,7 +185,9 @@ fn friction_is_compensated_on_the_identified_robot() {
     let h = config.dt / config.substeps as f64;
     assert_eq!(prediction_coulomb_sharpness(&plant, h), 100.0);
     let (mode, chart) = mode_and_chart::<_, 2, 4>(&plant, 0, 2.0, 9).unwrap();
-    let mut ctrl = Controller::<_, 2, 4>::new(plant, config, Reference::Curved(chart)).unwrap();
+    let mut ctrl =
+        Controller::<_, 2, 4>::new(plant, config, Reference::with_chart(Variant::Curved, chart))
+            .unwrap();
     let z0 = SVector::<f64, 4>::new(0.05, 0.05, 0.0, 0.0);
     let trace = run_tuned(&mut ctrl, &plant, &z0, 25.0, |_, _| {}).unwrap();
     let s = summarise(&trace, 2.0, Some(&mode.path), 5.0);

@@ -3,6 +3,7 @@
 
 use eigenmpc::mechanics::DoublePendulum;
 use eigenmpc::modes::linear_modes;
+use eigenmpc::mpc::Guide;
 use eigenmpc::mpc::closed_loop::{Sample, Summary, mode_and_chart, run, summarise};
 use eigenmpc::mpc::{Controller, MpcConfig, QpBackend, Reference, Variant};
 use nalgebra::SVector;
@@ -28,9 +29,11 @@ fn scenario_with(
     let sys = DoublePendulum::default();
     let (mode, chart) = mode_and_chart::<_, 2, 4>(&sys, family, e_ref, 9).unwrap();
     let reference = match variant {
-        Variant::Straight => Reference::Straight {
-            eigenvector: linear_modes(&sys).unwrap()[family].eigenvector,
-        },
+        Variant::Straight => Reference::new(
+            Variant::Straight,
+            Guide::Line(linear_modes(&sys).unwrap()[family].eigenvector),
+        )
+        .unwrap(),
         chart_variant => Reference::with_chart(chart_variant, chart),
     };
     let mut config = MpcConfig::paper(variant);

@@ -19,6 +19,15 @@ fn physics_columns(csv: &str) -> Vec<Vec<String>> {
         .collect()
 }
 
+/// `eigenmpc simulate`'s time to the band (s).
+fn band_of(simulate: &str) -> f64 {
+    simulate
+        .lines()
+        .find_map(|l| l.strip_prefix("time to |E - E_ref| < 5 % for good:"))
+        .and_then(|v| v.trim().trim_end_matches(" s").parse::<f64>().ok())
+        .expect("simulate's time to band")
+}
+
 #[test]
 fn a_grid_spec_runs_the_same_on_1_and_2_threads() {
     let base = std::env::temp_dir().join(format!("eigenmpc-sweep-{}", std::process::id()));
@@ -205,11 +214,7 @@ fn a_robot_file_sweep_repeats_simulate() {
         "30",
         "--chart-family",
     ]);
-    let band = stdout
-        .lines()
-        .find_map(|l| l.strip_prefix("time to |E - E_ref| < 5 % for good:"))
-        .and_then(|v| v.trim().trim_end_matches(" s").parse::<f64>().ok())
-        .expect("simulate's time to band");
+    let band = band_of(&stdout);
     let sweep: f64 = rows[1][col("time_to_band")].parse().unwrap();
     assert!(
         (sweep - band).abs() < 1e-3,
@@ -220,4 +225,129 @@ fn a_robot_file_sweep_repeats_simulate() {
         stdout.contains(&format!("{error:.4} J")),
         "{error}: {stdout}"
     );
+}
+
+#[test]
+fn a_four_joint_robot_file_sweep_repeats_simulate() {
+    let robot = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../robots/examples/four-link-rigid.yml"
+    );
+    let dir = std::env::temp_dir().join(format!("eigenmpc-sweep-4-{}", std::process::id()));
+    let stdout = eigenmpc_ok(&[
+        "sweep",
+        "--model",
+        robot,
+        "--grid",
+        "controller.E_ref=1",
+        "--duration",
+        "15",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(stdout.contains("1 reached the 5 % band"), "{stdout}");
+    let rows = physics_columns(&std::fs::read_to_string(dir.join("sweep.csv")).unwrap());
+    let col = |name: &str| rows[0].iter().position(|c| c == name).unwrap();
+    // One torque column per joint, and no fifth.
+    assert!(rows[0].iter().any(|c| c == "rms_torque_4"));
+    assert!(!rows[0].iter().any(|c| c == "rms_torque_5"));
+    let simulate = eigenmpc_ok(&[
+        "simulate",
+        "--model",
+        robot,
+        "--energy",
+        "1",
+        "--duration",
+        "15",
+        "--chart-family",
+    ]);
+    let band = band_of(&simulate);
+    let sweep: f64 = rows[1][col("time_to_band")].parse().unwrap();
+    assert!(
+        (sweep - band).abs() < 1e-9,
+        "sweep {sweep} s, simulate {band} s"
+    );
+    let torques: Vec<String> = (1..=4)
+        .map(|j| {
+            let t: f64 = rows[1][col(&format!("rms_torque_{j}"))].parse().unwrap();
+            format!("{t:.4}")
+        })
+        .collect();
+    let line = format!(
+        "RMS torque, last 5 s:            {} N m",
+        torques.join(" / ")
+    );
+    assert!(simulate.contains(&line), "{line}\n{simulate}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_sweep_split_in_parts_merges_into_the_same_outputs() {
+    let base = std::env::temp_dir().join(format!("eigenmpc-sweep-parts-{}", std::process::id()));
+    std::fs::create_dir_all(&base).unwrap();
+    let spec = base.join("spec.toml");
+    std::fs::write(
+        &spec,
+        "duration = 6.0\n[grid]\n\"controller.E_ref\" = [10.0, 14.0]\n\
+         [random]\nsamples = 2\nseed = 5\n[random.ranges]\n\"model.m[2]\" = { from = 0.9, to = 1.1 }\n",
+    )
+    .unwrap();
+    let spec = spec.to_str().unwrap();
+    let plan: serde_json::Value =
+        serde_json::from_str(&eigenmpc_ok(&["sweep", "--spec", spec, "--plan"])).unwrap();
+    assert_eq!(
+        plan,
+        serde_json::json!({"runs": 4, "joints": 2, "swept": ["controller.E_ref", "model.m[2]"]})
+    );
+    let whole = base.join("whole");
+    eigenmpc_ok(&["sweep", "--spec", spec, "--out", whole.to_str().unwrap()]);
+    let mut parts = vec![];
+    for (i, range) in ["0..1", "1..4"].iter().enumerate() {
+        let part = base.join(format!("part{i}.json"));
+        eigenmpc_ok(&[
+            "sweep",
+            "--spec",
+            spec,
+            "--only",
+            range,
+            "--rows-out",
+            part.to_str().unwrap(),
+        ]);
+        parts.push(part);
+    }
+    let merged = base.join("merged");
+    let stdout = eigenmpc_ok(&[
+        "sweep",
+        "--spec",
+        spec,
+        "--from-rows",
+        parts[1].to_str().unwrap(),
+        "--from-rows",
+        parts[0].to_str().unwrap(),
+        "--out",
+        merged.to_str().unwrap(),
+    ]);
+    assert!(
+        stdout.contains("4 runs of 6 s merged from 2 record file(s)"),
+        "{stdout}"
+    );
+    let read = |dir: &std::path::Path| std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
+    assert_eq!(
+        physics_columns(&read(&merged)),
+        physics_columns(&read(&whole))
+    );
+    // A part missing is an error naming the run, and nothing is written.
+    let o = eigenmpc(&[
+        "sweep",
+        "--spec",
+        spec,
+        "--from-rows",
+        parts[1].to_str().unwrap(),
+        "--out",
+        base.join("incomplete").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("no record of run(s) 0"));
+    assert!(!base.join("incomplete").join("sweep.csv").exists());
+    std::fs::remove_dir_all(&base).ok();
 }

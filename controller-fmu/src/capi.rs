@@ -43,7 +43,7 @@ const _: () =
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EigenMpcConfig {
-    /// `EIGENMPC_VARIANT_STRAIGHT` (1) or `EIGENMPC_VARIANT_CURVED` (2).
+    /// An `EIGENMPC_VARIANT_*` item (straight 1, curved 2, hybrid 3: the variant table).
     pub variant: i32,
     /// Reference energy E_ref (J), >= 0.
     pub e_ref: f64,

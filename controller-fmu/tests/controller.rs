@@ -379,7 +379,7 @@ fn initialization_fails(fmu: &Fmu, needles: &[&str]) {
 fn chart_in_use(fmu: &Fmu) -> Chart<2> {
     let instance = unsafe { &*(fmu.c as *const fmi2_slave::Instance<EigenMpcFmu>) };
     match instance.model().unwrap().controller().reference() {
-        eigenmpc::mpc::Reference::Curved(chart) => chart.clone(),
+        r if r.variant() == eigenmpc::mpc::Variant::Curved => r.chart().unwrap().clone(),
         other => panic!("not curved: {other:?}"),
     }
 }

@@ -31,7 +31,8 @@ pub const MAGIC: [u8; 8] = *b"EMPCSTAT";
 
 /// Version of the layout and of the snapshot encoding. A build that changes
 /// either increments it (and the GUID changes with any variable table).
-pub const FORMAT_VERSION: u32 = 1;
+/// 2: the controller's reference is a variant and its guide (line or chart).
+pub const FORMAT_VERSION: u32 = 2;
 
 /// Largest serialized state accepted (bytes): far above any real state
 /// (tens of kilobytes), small enough that a corrupt length cannot make the
@@ -207,8 +208,8 @@ mod tests {
         bad[0] ^= 1;
         assert!(decode("{guid-1}", &bad).unwrap_err().contains("magic"));
         let mut bad = bytes.clone();
-        bad[8] = 2;
-        assert!(decode("{guid-1}", &bad).unwrap_err().contains("version 2"));
+        bad[8] = 9;
+        assert!(decode("{guid-1}", &bad).unwrap_err().contains("version 9"));
         let mut bad = bytes.clone();
         *bad.last_mut().unwrap() ^= 0x10;
         assert!(decode("{guid-1}", &bad).unwrap_err().contains("checksum"));

@@ -4,7 +4,7 @@
 
 use crate::controller::settings::{ChartSource, StateEstimator};
 use eigenmpc::adapt::AdaptationStatus;
-use eigenmpc::mpc::{QpBackend, Variant};
+use eigenmpc::mpc::{QpBackend, VARIANTS, Variant};
 use fmi2_slave::EnumerationType;
 
 /// One item of an enumeration.
@@ -75,30 +75,34 @@ impl<T: Copy + PartialEq + std::fmt::Debug + 'static> Enumeration<T> {
     }
 }
 
+/// The `variant` items, one per row of the core's variant table
+/// ([`VARIANTS`]: items 1, 2, ... in its order, its names and descriptions).
+const VARIANT_ITEMS: [Item<Variant>; VARIANTS.len()] = {
+    let mut items = [Item {
+        name: "",
+        item: 0,
+        value: Variant::Curved,
+        description: "",
+    }; VARIANTS.len()];
+    let mut i = 0;
+    while i < VARIANTS.len() {
+        let row = &VARIANTS[i];
+        items[i] = Item {
+            name: row.name,
+            item: i as i32 + 1,
+            value: row.variant,
+            description: row.description,
+        };
+        i += 1;
+    }
+    items
+};
+
 /// `variant`: which EigenMPC cost.
 pub const VARIANT: Enumeration<Variant> = Enumeration {
     type_name: "Variant",
     parameter: "variant",
-    items: &[
-        Item {
-            name: "straight",
-            item: 1,
-            value: Variant::Straight,
-            description: "Distance to the linear eigenvector line",
-        },
-        Item {
-            name: "curved",
-            item: 2,
-            value: Variant::Curved,
-            description: "Distance to the eigenmode chart X(s)",
-        },
-        Item {
-            name: "hybrid",
-            item: 3,
-            value: Variant::Hybrid,
-            description: "Distance to the chart X(s), blended by tanh(alpha E) as straight",
-        },
-    ],
+    items: &VARIANT_ITEMS,
 };
 
 /// `qp_solver`: the QP solver of the real-time iteration.
@@ -224,8 +228,12 @@ mod tests {
 
     #[test]
     fn every_library_value_has_one_item_and_back() {
-        for v in [Variant::Straight, Variant::Curved, Variant::Hybrid] {
-            assert_eq!(VARIANT.value(VARIANT.item(v)), Ok(v));
+        for row in VARIANTS {
+            assert_eq!(VARIANT.value(VARIANT.item(row.variant)), Ok(row.variant));
+            assert_eq!(
+                VARIANT.items[VARIANT.item(row.variant) as usize - 1].name,
+                row.name
+            );
         }
         for b in QpBackend::ALL {
             assert_eq!(QP_SOLVER.value(QP_SOLVER.item(b)), Ok(b));

@@ -256,6 +256,24 @@ pub fn settings_from_named<const N: usize>(values: &[(&str, f64)]) -> Result<Set
     crate::controller::table::table::<N>().settings_from_named(&d, defaults, values)
 }
 
+/// The `N`-joint plant settings with the FMU parameters `(name, value)` set
+/// over the defaults, each checked as `fmi2Set*` would check it; messages
+/// name the shipped plant (`DoublePendulum`, `TriplePendulum`) or the
+/// count.
+pub fn plant_settings_from_named<const N: usize>(
+    values: &[(&str, f64)],
+) -> Result<crate::plant::settings::PlantSettings<N>, String> {
+    use crate::plant::settings::PlantSettings;
+    let name = match N {
+        2 => DoublePendulumPlant::MODEL_NAME.to_string(),
+        3 => TriplePendulumPlant::MODEL_NAME.to_string(),
+        n => format!("the {n}-joint plant"),
+    };
+    let defaults = PlantSettings::<N>::default();
+    let d = crate::plant::description_with::<N>(&name, "", &defaults);
+    crate::plant::table::table::<N>().settings_from_named(&d, defaults, values)
+}
+
 /// Checks `name = x` as `fmi2Set*` would for an `N`-joint controller (the
 /// ranges do not depend on the product).
 pub fn check_named<const N: usize>(name: &str, x: f64) -> Result<(), String> {

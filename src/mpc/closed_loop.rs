@@ -206,25 +206,31 @@ pub fn reference_for<S, const N: usize, const NX: usize>(
     variant: super::Variant,
     mode_index: usize,
     energy: f64,
-) -> Result<super::Reference<N>, crate::modes::ModeError>
+) -> Result<super::Reference<N>, String>
 where
     S: MechanicalSystem<N>,
 {
-    Ok(match variant {
-        super::Variant::Straight => super::Reference::Straight {
-            eigenvector: crate::modes::linear_modes(system)?
+    super::Reference::of(
+        variant,
+        || {
+            crate::modes::linear_modes(system)
+                .map_err(|e| e.to_string())?
                 .get(mode_index)
-                .ok_or(crate::modes::ModeError::NoSuchMode {
-                    index: mode_index,
-                    dof: N,
-                })?
-                .eigenvector,
+                .map(|m| m.eigenvector)
+                .ok_or_else(|| {
+                    crate::modes::ModeError::NoSuchMode {
+                        index: mode_index,
+                        dof: N,
+                    }
+                    .to_string()
+                })
         },
-        chart_variant => super::Reference::with_chart(
-            chart_variant,
-            mode_and_chart::<S, N, NX>(system, mode_index, energy, 9)?.1,
-        ),
-    })
+        || {
+            mode_and_chart::<S, N, NX>(system, mode_index, energy, 9)
+                .map(|(_, chart)| chart)
+                .map_err(|e| e.to_string())
+        },
+    )
 }
 
 /// Deterministic Gaussian noise for measured closed loops (xorshift64* and

@@ -258,3 +258,9 @@ pub enum MpcError {
     #[error("saved state does not fit: {0}")]
     InvalidState(String),
 }
+
+impl From<super::ReferenceError> for MpcError {
+    fn from(e: super::ReferenceError) -> Self {
+        MpcError::InvalidReference(e.0)
+    }
+}

@@ -28,15 +28,16 @@ pub mod prediction;
 mod saved;
 mod sqp;
 mod status;
-mod variant;
 
 pub use config::{MAX_COMPENSATED_TIME, MAX_HORIZON, MpcConfig, MpcError, SqpOptions};
-pub use cost::{CostParams, PAPER_ENERGY_SCALE, Reference, Weights};
+pub use cost::{
+    CostParams, CostVariant, Guide, PAPER_ENERGY_SCALE, Reference, ReferenceError, VARIANTS,
+    Variant, VariantInfo, Weights,
+};
 pub use estimator::EstimatorConfig;
 pub use prediction::{prediction_coulomb_sharpness, prediction_substeps};
 pub use saved::ControllerState;
 pub use status::{ControlOutput, ControlStatus};
-pub use variant::{VARIANTS, Variant, VariantInfo};
 
 use crate::mechanics::{MechanicalSystem, Vector, state_energy};
 use crate::modes::ChartFamily;

@@ -84,6 +84,7 @@ where
                 self.reference.variant()
             ));
         }
+        state.reference.validate().map_err(MpcError::InvalidState)?;
         if state.family.is_some() != self.family.is_some()
             || state.estimator.is_some() != self.estimator.is_some()
         {

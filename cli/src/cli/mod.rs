@@ -217,6 +217,21 @@ pub fn prepare_out_dir(dir: &std::path::Path) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// `--variant`: its values, and their help, are the rows of the core's
+/// variant table (a new variant shows up here by itself).
+pub fn variant_parser() -> impl clap::builder::TypedValueParser<Value = eigenmpc::mpc::Variant> {
+    use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+    PossibleValuesParser::new(
+        eigenmpc::mpc::VARIANTS
+            .iter()
+            .map(|v| PossibleValue::new(v.name).help(v.description)),
+    )
+    .map(|name| {
+        name.parse::<eigenmpc::mpc::Variant>()
+            .expect("every value offered is a row of the table")
+    })
+}
+
 /// Parses a comma-separated list of numbers (`"2,8,14"`).
 pub fn parse_list(name: &str, text: &str) -> anyhow::Result<Vec<f64>> {
     text.split(',')

@@ -27,9 +27,9 @@ use std::path::{Path, PathBuf};
 /// Arguments of `eigenmpc simulate`.
 #[derive(Args, Debug)]
 pub struct SimulateArgs {
-    /// Cost variant: `straight`, `curved` or `hybrid` (curved blended by tanh(alpha E)).
-    #[arg(long, default_value = "curved")]
-    variant: String,
+    /// Cost variant.
+    #[arg(long, default_value = "curved", value_parser = super::variant_parser())]
+    variant: Variant,
     /// Mode family: `in-phase` or `anti-phase`.
     #[arg(long, default_value = "in-phase")]
     family: String,
@@ -292,7 +292,7 @@ pub fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
 fn run_simulate_for<const N: usize, const S: usize, const NP: usize>(
     args: &SimulateArgs,
 ) -> anyhow::Result<()> {
-    let variant: Variant = args.variant.parse().map_err(anyhow::Error::msg)?;
+    let variant = args.variant;
     let family: Family = args.family.parse().map_err(anyhow::Error::msg)?;
     let backend: QpBackend = args.qp.parse().map_err(anyhow::Error::msg)?;
     let x0 = match &args.x0 {
@@ -431,30 +431,26 @@ fn run_simulate_for<const N: usize, const S: usize, const NP: usize>(
         }
         Controller::<_, N, S>::with_family_as(model, config, chart_family, variant)?
     } else {
-        let reference = match variant {
-            Variant::Straight => Reference::Straight {
-                eigenvector: linear_modes(&model)?
+        let reference = Reference::of::<anyhow::Error>(
+            variant,
+            || {
+                Ok(linear_modes(&model)?
                     .get(family.index())
                     .with_context(|| format!("a {N}-joint chain has no {family} family"))?
-                    .eigenvector,
+                    .eigenvector)
             },
-            chart_variant => Reference::with_chart(
-                chart_variant,
-                match &args.chart {
-                    Some(path) => chart_from_json(path, args.energy, family)?,
-                    None => {
-                        mode_and_chart::<_, N, S>(
-                            &model,
-                            family.index(),
-                            args.energy,
-                            args.chart_degree,
-                        )
-                        .with_context(|| format!("{family} eigenmode at {} J", args.energy))?
-                        .1
-                    }
-                },
-            ),
-        };
+            || match &args.chart {
+                Some(path) => chart_from_json(path, args.energy, family),
+                None => Ok(mode_and_chart::<_, N, S>(
+                    &model,
+                    family.index(),
+                    args.energy,
+                    args.chart_degree,
+                )
+                .with_context(|| format!("{family} eigenmode at {} J", args.energy))?
+                .1),
+            },
+        )?;
         Controller::<_, N, S>::new(model, config, reference)?
     };
     let (mode, _) = mode_and_chart::<_, N, S>(&plant, family.index(), e_final, 9)

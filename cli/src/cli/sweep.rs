@@ -5,7 +5,8 @@
 use anyhow::{Context, bail};
 use clap::Args;
 use eigenmpc_cli::sweep::report::{Row, check_metric, csv, json, plot};
-use eigenmpc_cli::sweep::{Axis, RandomSample, RunSetup, Spec, Uniform, run};
+use eigenmpc_cli::sweep::rows::{Record, merge, parse_range};
+use eigenmpc_cli::sweep::{Axis, RandomSample, Spec, Uniform, setups};
 use indicatif::{ParallelProgressIterator, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use std::path::PathBuf;
@@ -50,6 +51,26 @@ pub struct SweepArgs {
     /// Worker threads (default: all local cores); the numbers do not depend on it.
     #[arg(long)]
     threads: Option<usize>,
+    /// Print the sweep's plan as JSON (`runs`, `joints`, `swept`) and run nothing: what a
+    /// distributed runner splits.
+    #[arg(long, conflicts_with_all = ["only", "from_rows"])]
+    plan: bool,
+    /// Run only the runs FROM..TO (indices in the spec's order, TO excluded) and write their
+    /// records (JSON) to --rows-out instead of the outputs: one worker's part of the sweep.
+    #[arg(
+        long,
+        value_name = "FROM..TO",
+        requires = "rows_out",
+        conflicts_with = "from_rows"
+    )]
+    only: Option<String>,
+    /// Where --only writes its records (`-`: standard output).
+    #[arg(long, value_name = "FILE")]
+    rows_out: Option<PathBuf>,
+    /// Run nothing: merge these records (of every run, from the --only parts) into the
+    /// outputs, as if the sweep had run here. Repeatable.
+    #[arg(long = "from-rows", value_name = "FILE")]
+    from_rows: Vec<PathBuf>,
 }
 
 fn split_assignment<'a>(flag: &str, text: &'a str) -> anyhow::Result<(&'a str, &'a str)> {
@@ -145,31 +166,26 @@ fn spec(args: &SweepArgs) -> anyhow::Result<Spec> {
     Ok(spec)
 }
 
-/// Runs the sweep and writes its outputs.
-pub fn run_sweep(args: &SweepArgs) -> anyhow::Result<()> {
-    let spec = spec(args)?;
-    let metric = spec.metric.clone().unwrap_or("time_to_band".into());
-    check_metric(&metric).map_err(anyhow::Error::msg)?;
-    let runs = spec.runs().map_err(anyhow::Error::msg)?;
-    let swept = spec.swept();
-    // Every run's set-up is checked before the first closed loop starts.
-    let setups = runs
-        .iter()
-        .enumerate()
-        .map(|(i, run)| {
-            RunSetup::new(&spec, run).map_err(|e| {
-                let values: Vec<String> = run.iter().map(|(n, v)| format!("{n} = {v}")).collect();
-                anyhow::anyhow!("run {i} ({}): {e}", values.join(", "))
-            })
-        })
-        .collect::<anyhow::Result<Vec<_>>>()?;
-    // An unwritable output folder is found now, not after the sweep.
-    super::prepare_out_dir(&args.out)?;
+/// The outcomes of runs in order, the wall time (s) and the thread count.
+type Executed = (
+    Vec<Result<eigenmpc_cli::sweep::Metrics, String>>,
+    f64,
+    usize,
+);
+
+/// Runs `setups` on the local cores with a progress bar: the outcomes in
+/// order, the wall time (s) and the thread count.
+fn execute(
+    args: &SweepArgs,
+    setups: &[Box<dyn eigenmpc_cli::sweep::SweepRun>],
+    duration: f64,
+) -> anyhow::Result<Executed> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads.unwrap_or(0))
         .build()
         .context("thread pool")?;
-    let bar = ProgressBar::with_draw_target(Some(runs.len() as u64), ProgressDrawTarget::stderr());
+    let bar =
+        ProgressBar::with_draw_target(Some(setups.len() as u64), ProgressDrawTarget::stderr());
     bar.set_style(
         ProgressStyle::with_template("sweep [{bar:30}] {pos}/{len} runs, {elapsed} ({eta} left)")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
@@ -179,21 +195,75 @@ pub fn run_sweep(args: &SweepArgs) -> anyhow::Result<()> {
         setups
             .par_iter()
             .progress_with(bar.clone())
-            .map(|setup| run(setup, spec.duration))
+            .map(|setup| setup.run(duration))
             .collect()
     });
-    let wall = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
-    let rows: Vec<Row> = runs
-        .into_iter()
-        .zip(outcomes)
-        .map(|(values, outcome)| Row { values, outcome })
-        .collect();
+    Ok((
+        outcomes,
+        start.elapsed().as_secs_f64(),
+        pool.current_num_threads(),
+    ))
+}
+
+/// Runs the sweep (or its part, or merges its parts) and writes its outputs.
+pub fn run_sweep(args: &SweepArgs) -> anyhow::Result<()> {
+    let spec = spec(args)?;
+    let joints = spec.joint_count().map_err(anyhow::Error::msg)?;
+    let metric = spec.metric.clone().unwrap_or("time_to_band".into());
+    check_metric(&metric, joints).map_err(anyhow::Error::msg)?;
+    let runs = spec.runs().map_err(anyhow::Error::msg)?;
+    let swept = spec.swept();
+    if args.plan {
+        let plan = serde_json::json!({"runs": runs.len(), "joints": joints, "swept": swept});
+        println!("{plan}");
+        return Ok(());
+    }
+    // Every run's set-up is checked before the first closed loop starts
+    // (also when merging: the records must be of a valid spec).
+    let setups = setups(&spec, &runs).map_err(anyhow::Error::msg)?;
+    if let Some(only) = &args.only {
+        let part = parse_range(only, runs.len()).map_err(anyhow::Error::msg)?;
+        let out = args.rows_out.as_ref().context("--only needs --rows-out")?;
+        let (outcomes, _, _) = execute(args, &setups[part.clone()], spec.duration)?;
+        let records: Vec<Record> = part
+            .zip(outcomes)
+            .map(|(i, outcome)| Record::new(i, &runs[i], &outcome))
+            .collect();
+        let text = serde_json::to_string(&records)? + "\n";
+        if out.as_os_str() == "-" {
+            print!("{text}");
+        } else {
+            std::fs::write(out, text).with_context(|| format!("writing {}", out.display()))?;
+        }
+        return Ok(());
+    }
+    // An unwritable output folder is found now, not after the sweep.
+    super::prepare_out_dir(&args.out)?;
+    let (rows, timing) = if args.from_rows.is_empty() {
+        let (outcomes, wall, threads) = execute(args, &setups, spec.duration)?;
+        let rows: Vec<Row> = runs
+            .into_iter()
+            .zip(outcomes)
+            .map(|(values, outcome)| Row { values, outcome })
+            .collect();
+        (rows, Some((wall, threads)))
+    } else {
+        let mut records = Vec::new();
+        for path in &args.from_rows {
+            let text = std::fs::read_to_string(path)
+                .with_context(|| format!("reading {}", path.display()))?;
+            let part: Vec<Record> = serde_json::from_str(&text)
+                .with_context(|| format!("{}: not sweep records", path.display()))?;
+            records.extend(part);
+        }
+        (merge(&runs, records).map_err(anyhow::Error::msg)?, None)
+    };
     let write = |name: &str, text: String| -> anyhow::Result<()> {
         let path = args.out.join(name);
         std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))
     };
-    write("sweep.csv", csv(&swept, &rows))?;
+    write("sweep.csv", csv(&swept, &rows, joints))?;
     write(
         "sweep.json",
         serde_json::to_string_pretty(&json(&rows))? + "\n",
@@ -218,19 +288,27 @@ pub fn run_sweep(args: &SweepArgs) -> anyhow::Result<()> {
         .iter()
         .filter(|r| r.outcome.as_ref().is_ok_and(|m| m.success))
         .count();
-    let threads = pool.current_num_threads();
-    println!(
-        "{} runs of {} s in {wall:.2} s on {threads} thread(s): {:.2} runs/s per thread; {successes} \
-         reached the 5 % band and held it{}",
-        rows.len(),
-        spec.duration,
-        rows.len() as f64 / wall / threads as f64,
-        if failed > 0 {
-            format!("; {failed} failed (see the error column)")
-        } else {
-            String::new()
-        }
-    );
+    let failures = if failed > 0 {
+        format!("; {failed} failed (see the error column)")
+    } else {
+        String::new()
+    };
+    match timing {
+        Some((wall, threads)) => println!(
+            "{} runs of {} s in {wall:.2} s on {threads} thread(s): {:.2} runs/s per thread; \
+             {successes} reached the 5 % band and held it{failures}",
+            rows.len(),
+            spec.duration,
+            rows.len() as f64 / wall / threads as f64,
+        ),
+        None => println!(
+            "{} runs of {} s merged from {} record file(s); {successes} reached the 5 % band \
+             and held it{failures}",
+            rows.len(),
+            spec.duration,
+            args.from_rows.len(),
+        ),
+    }
     println!(
         "wrote {}/sweep.csv, sweep.json, sweep.png, sweep.svg",
         args.out.display()

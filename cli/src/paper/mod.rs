@@ -12,7 +12,7 @@ pub mod figures;
 use eigenmpc::mechanics::{DoublePendulum, PlanarChainParams, Vector};
 use eigenmpc::modes::{Chart, Eigenmode, Family, linear_modes};
 use eigenmpc::mpc::closed_loop::{Sample, Summary, mode_and_chart, run, summarise};
-use eigenmpc::mpc::{Controller, MpcConfig, Reference, Variant};
+use eigenmpc::mpc::{Controller, MpcConfig, Reference, ReferenceError, Variant};
 use nalgebra::SVector;
 
 /// The model the cost's chart is computed for.
@@ -274,15 +274,12 @@ pub fn run_one(spec: &RunSpec, modes: &Modes, duration: f64) -> Result<RunResult
     // The paper's residual r_E = E_ref - E: its Fig. 3 runs are at 2 and
     // 12 J (from 14 J up the default scale gives the same numbers, bit for bit).
     config.cost.energy_scale = 0.0;
-    let reference = match spec.variant {
-        Variant::Straight => Reference::Straight {
-            eigenvector: eigenvector(spec.family),
-        },
-        v => Reference::with_chart(
-            v,
-            modes.get(spec.chart, spec.family, spec.e_ref).chart.clone(),
-        ),
-    };
+    let reference = Reference::of::<ReferenceError>(
+        spec.variant,
+        || Ok(eigenvector(spec.family)),
+        || Ok(modes.get(spec.chart, spec.family, spec.e_ref).chart.clone()),
+    )
+    .map_err(|e| format!("{}: {e}", spec.id))?;
     let fail = |e: String| format!("{}: {e}", spec.id);
     let mut controller =
         Controller::<_, 2, 4>::new(plant, config, reference).map_err(|e| fail(e.to_string()))?;

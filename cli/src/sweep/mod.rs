@@ -9,10 +9,18 @@
 //! same values. The runs are independent and their order is fixed by the
 //! spec: the numbers do not depend on the thread count.
 //!
+//! Any robot of the joint-count table: the spec's `model` file says how many
+//! joints (2, the paper's pendulum, without one), and [`setups`] picks the
+//! sizes once for the whole sweep.
+//!
 //! - this file: the spec, its expansion into runs, one run;
-//! - [`report`]: CSV, JSON and the plot.
+//! - [`report`]: CSV, JSON and the plot;
+//! - [`rows`]: the rows as records, for a sweep spread over machines (the
+//!   Python/Dask runner calls this sweep on each worker, `--only`, and merges
+//!   the records, `--from-rows`).
 
 pub mod report;
+pub mod rows;
 
 use eigenmpc::adapt::Adaptation;
 use eigenmpc::mechanics::{PlanarChainParams, Vector};
@@ -20,11 +28,12 @@ use eigenmpc::model_file::RobotFile;
 use eigenmpc::mpc::closed_loop::{GaussianNoise, energy_tail, mode_and_chart, summarise};
 use eigenmpc::robustness::{Imperfections, run_imperfect};
 use eigenmpc_fmu_models::chain::ChainParameters;
-use eigenmpc_fmu_models::controller::named::settings_from_named;
+use eigenmpc_fmu_models::controller;
 use eigenmpc_fmu_models::controller::settings::Settings;
-use eigenmpc_fmu_models::controller::{self, ControllerProduct};
 use eigenmpc_fmu_models::plant::{self, settings::PlantSettings};
-use eigenmpc_fmu_models::products::{DoublePendulumPlant, EigenMpc2};
+use eigenmpc_fmu_models::products::{
+    default_settings, plant_settings_from_named, settings_from_named,
+};
 use fmi2_slave::Value;
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
@@ -34,10 +43,17 @@ use std::path::{Path, PathBuf};
 /// Scored window at the end of every run (s).
 pub const WINDOW: f64 = 5.0;
 
-/// Values every run starts from, before the spec's: the paper's start
-/// state, both joints at 0.05 rad at rest (the plant FMU's own default is
-/// the chain hanging at rest, where the controller has nothing to do).
-pub const BASE: [(&str, f64); 2] = [("plant.q0[1]", 0.05), ("plant.q0[2]", 0.05)];
+/// The angle every joint starts from (rad), at rest, before the spec's
+/// values: the paper's start state (the plant FMU's own default is the
+/// chain hanging at rest, where the controller has nothing to do).
+pub const START_ANGLE: f64 = 0.05;
+
+/// `plant.q0[j] = START_ANGLE` for the `joints` joints.
+pub fn base_values(joints: usize) -> Vec<(String, f64)> {
+    (1..=joints)
+        .map(|j| (format!("plant.q0[{j}]"), START_ANGLE))
+        .collect()
+}
 
 /// The values of one swept parameter.
 #[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
@@ -171,6 +187,17 @@ impl Spec {
         Ok(Spec { model, ..spec })
     }
 
+    /// Joints of the swept robot: the `model` file's, 2 (the paper's
+    /// pendulum) without one.
+    pub fn joint_count(&self) -> Result<usize, String> {
+        match &self.model {
+            Some(path) => RobotFile::load(path)
+                .map(|f| f.links())
+                .map_err(|e| e.to_string()),
+            None => Ok(2),
+        }
+    }
+
     /// The swept names, in the order of the CSV columns.
     pub fn swept(&self) -> Vec<String> {
         let mut names: Vec<String> = self.grid.keys().cloned().collect();
@@ -292,11 +319,11 @@ impl<'a> Target<'a> {
 /// One run's set-up: the controller and plant settings and the
 /// imperfections, from the spec's fixed values and the run's swept ones.
 #[derive(Clone, Debug)]
-pub struct RunSetup {
+pub struct RunSetup<const N: usize> {
     /// The controller FMU's settings.
-    pub controller: Settings<2>,
+    pub controller: Settings<N>,
     /// The plant FMU's settings (initial state included).
-    pub plant: PlantSettings<2>,
+    pub plant: PlantSettings<N>,
     /// Noise, motor and delay.
     pub imperfections: Imperfections,
 }
@@ -306,9 +333,9 @@ type Named = Vec<(String, f64)>;
 
 /// FMU parameter values of a robot file, for the controller's and the
 /// plant's tables.
-fn file_values(file: &Path) -> Result<(Named, Named), String> {
+fn file_values<const N: usize>(file: &Path) -> Result<(Named, Named), String> {
     let params = RobotFile::load(file)
-        .and_then(|f| f.params::<2>())
+        .and_then(|f| f.params::<N>())
         .map_err(|e| e.to_string())?;
     let chain = ChainParameters::from_params(&params)?;
     let number = |v: Value| match v {
@@ -316,18 +343,18 @@ fn file_values(file: &Path) -> Result<(Named, Named), String> {
         Value::Integer(i) => i as f64,
         Value::Boolean(b) => f64::from(u8::from(b)),
     };
-    let mut c = EigenMpc2::settings(eigenmpc::mpc::Variant::Curved);
+    let mut c = default_settings::<N>(eigenmpc::mpc::Variant::Curved);
     c.model = chain;
-    let controller = controller::table::table::<2>()
+    let controller = controller::table::table::<N>()
         .start_values(&c, |_| true)
         .into_iter()
         .map(|(n, v)| (n, number(v)))
         .collect();
-    let p = PlantSettings::<2> {
+    let p = PlantSettings::<N> {
         model: chain,
         ..PlantSettings::default()
     };
-    let plant = plant::table::table::<2>()
+    let plant = plant::table::table::<N>()
         .start_values(&p, |_| true)
         .into_iter()
         .map(|(n, v)| (n, number(v)))
@@ -335,21 +362,21 @@ fn file_values(file: &Path) -> Result<(Named, Named), String> {
     Ok((controller, plant))
 }
 
-impl RunSetup {
+impl<const N: usize> RunSetup<N> {
     /// The set-up of `spec` with the swept values `run`, each checked as
     /// the FMUs check them.
     pub fn new(spec: &Spec, run: &[(String, f64)]) -> Result<Self, String> {
         let (mut controller, mut plant) = match &spec.model {
-            Some(file) => file_values(file)?,
+            Some(file) => file_values::<N>(file)?,
             None => (vec![], vec![]),
         };
         let mut imperfections = Imperfections {
             seed: spec.noise_seed,
             ..Imperfections::default()
         };
-        let base = BASE.iter().map(|(n, v)| (n.to_string(), *v));
+        let base = base_values(N);
         let fixed = spec.fixed.iter().map(|(n, v)| (n.clone(), *v));
-        for (name, value) in base.chain(fixed).chain(run.iter().cloned()) {
+        for (name, value) in base.into_iter().chain(fixed).chain(run.iter().cloned()) {
             match Target::parse(&name)? {
                 Target::Controller(n) => controller.push((n.to_string(), value)),
                 Target::Plant(n) => plant.push((n.to_string(), value)),
@@ -375,10 +402,10 @@ impl RunSetup {
         fn as_refs(v: &[(String, f64)]) -> Vec<(&str, f64)> {
             v.iter().map(|(n, x)| (n.as_str(), *x)).collect()
         }
-        let controller = settings_from_named::<EigenMpc2, 2>(&as_refs(&controller))
+        let controller = settings_from_named::<N>(&as_refs(&controller))
             .map_err(|e| format!("controller: {e}"))?;
-        let plant = plant::settings_from_named::<DoublePendulumPlant, 2>(&as_refs(&plant))
-            .map_err(|e| format!("plant: {e}"))?;
+        let plant =
+            plant_settings_from_named::<N>(&as_refs(&plant)).map_err(|e| format!("plant: {e}"))?;
         imperfections.validate()?;
         Ok(Self {
             controller,
@@ -388,8 +415,52 @@ impl RunSetup {
     }
 }
 
+/// A checked run of any joint count, ready to go: the sizes were picked
+/// once, by [`setups`].
+pub trait SweepRun: Send + Sync {
+    /// Runs the closed loop for `duration` seconds.
+    fn run(&self, duration: f64) -> Result<Metrics, String>;
+}
+
+/// A [`RunSetup`] with the sizes its closed loop needs.
+struct Sized<const N: usize, const S: usize, const NP: usize>(RunSetup<N>);
+
+impl<const N: usize, const S: usize, const NP: usize> SweepRun for Sized<N, S, NP> {
+    fn run(&self, duration: f64) -> Result<Metrics, String> {
+        run::<N, S, NP>(&self.0, duration)
+    }
+}
+
+/// The set-ups of `runs` (from [`Spec::runs`]), each checked before any
+/// closed loop starts; an error names the run and its values.
+pub fn setups(spec: &Spec, runs: &[Vec<(String, f64)>]) -> Result<Vec<Box<dyn SweepRun>>, String> {
+    fn typed<const N: usize, const S: usize, const NP: usize>(
+        spec: &Spec,
+        runs: &[Vec<(String, f64)>],
+    ) -> Result<Vec<Box<dyn SweepRun>>, String> {
+        runs.iter()
+            .enumerate()
+            .map(|(i, run)| {
+                RunSetup::<N>::new(spec, run)
+                    .map(|s| Box::new(Sized::<N, S, NP>(s)) as Box<dyn SweepRun>)
+                    .map_err(|e| {
+                        let values: Vec<String> =
+                            run.iter().map(|(n, v)| format!("{n} = {v}")).collect();
+                        format!("run {i} ({}): {e}", values.join(", "))
+                    })
+            })
+            .collect()
+    }
+    let n = spec.joint_count()?;
+    eigenmpc::with_joint_count!(
+        n,
+        |N, S, NP| typed::<N, S, NP>(spec, runs),
+        otherwise Err(eigenmpc::joints::unsupported(n))
+    )
+}
+
 /// The figures of one run (one CSV row besides its parameters).
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Metrics {
     /// The plant's energy entered the 5 % band for good at this time (s;
     /// None: never).
@@ -397,11 +468,14 @@ pub struct Metrics {
     /// The band was reached and held at least over the last 5 s.
     pub success: bool,
     /// Plant energy minus `E_ref` at the end (J).
+    #[serde(deserialize_with = "rows::number")]
     pub final_energy_error: f64,
     /// Mean plant energy over the last 5 s minus `E_ref`, relative.
+    #[serde(deserialize_with = "rows::number")]
     pub mean_energy_error: f64,
     /// RMS applied torque over the last 5 s per joint (N m).
-    pub rms_torque: [f64; 2],
+    #[serde(deserialize_with = "rows::numbers")]
+    pub rms_torque: Vec<f64>,
     /// RMS distance of the last 5 s of the path to the plant's own
     /// eigenmode at `E_ref` (rad; None: no mode there).
     pub distance_to_mode: Option<f64>,
@@ -411,16 +485,22 @@ pub struct Metrics {
     pub model_updates: usize,
     /// Compute time per sample, median and p99 (s): the only columns that
     /// depend on the machine.
+    #[serde(deserialize_with = "rows::pair")]
     pub solve_time: [f64; 2],
 }
 
-/// Runs one closed loop of `setup` for `duration` seconds.
-pub fn run(setup: &RunSetup, duration: f64) -> Result<Metrics, String> {
-    let mut controller = setup.controller.build::<4>()?;
-    let nominal: PlanarChainParams<2> = setup.controller.model.params();
+/// Runs one closed loop of `setup` for `duration` seconds (`S = 2 N`,
+/// `NP` the chain's base parameters, as [`eigenmpc::with_joint_count`]
+/// binds them).
+pub fn run<const N: usize, const S: usize, const NP: usize>(
+    setup: &RunSetup<N>,
+    duration: f64,
+) -> Result<Metrics, String> {
+    let mut controller = setup.controller.build::<S>()?;
+    let nominal: PlanarChainParams<N> = setup.controller.model.params();
     let mut adaptation = if setup.controller.adapt {
         Some(
-            Adaptation::<2, 4, 11>::new(&nominal, setup.controller.adapt_options())
+            Adaptation::<N, S, NP>::new(&nominal, setup.controller.adapt_options())
                 .map_err(|e| e.to_string())?,
         )
     } else {
@@ -428,7 +508,7 @@ pub fn run(setup: &RunSetup, duration: f64) -> Result<Metrics, String> {
     };
     let plant = setup.plant.system()?;
     let p = &setup.plant;
-    let z0 = SVector::<f64, 4>::new(p.q0[0], p.q0[1], p.qd0[0], p.qd0[1]);
+    let z0 = SVector::<f64, S>::from_iterator(p.q0.iter().chain(p.qd0.iter()).copied());
     let out = run_imperfect(
         &mut controller,
         adaptation.as_mut(),
@@ -440,8 +520,8 @@ pub fn run(setup: &RunSetup, duration: f64) -> Result<Metrics, String> {
     .map_err(|e| e.to_string())?;
     let e_ref = setup.controller.tuning.e_ref;
     // The plant's own mode at E_ref, in the family the controller follows.
-    let mode = mode_and_chart::<_, 2, 4>(&plant, setup.controller.mode, e_ref, 9).ok();
-    let path: Option<Vec<Vector<2>>> = mode.map(|(m, _)| m.path);
+    let mode = mode_and_chart::<_, N, S>(&plant, setup.controller.mode, e_ref, 9).ok();
+    let path: Option<Vec<Vector<N>>> = mode.map(|(m, _)| m.path);
     let summary = summarise(&out.samples, e_ref, path.as_deref(), WINDOW);
     let (mean, _) = energy_tail(&out.samples, e_ref, WINDOW);
     Ok(Metrics {
@@ -451,7 +531,7 @@ pub fn run(setup: &RunSetup, duration: f64) -> Result<Metrics, String> {
             .is_some_and(|t| t <= duration - WINDOW + 1e-9),
         final_energy_error: summary.final_energy_error,
         mean_energy_error: (mean - e_ref) / e_ref,
-        rms_torque: [summary.rms_torque[0], summary.rms_torque[1]],
+        rms_torque: summary.rms_torque.iter().copied().collect(),
         distance_to_mode: summary.rms_distance,
         failed_solves: summary.failures,
         model_updates: out.model_updates,
@@ -524,7 +604,7 @@ mod tests {
             ("imperfections.responsiveness", 0.0, "responsiveness = 0"),
         ] {
             let spec = Spec::default();
-            let e = RunSetup::new(&spec, &[(name.to_string(), value)]).unwrap_err();
+            let e = RunSetup::<2>::new(&spec, &[(name.to_string(), value)]).unwrap_err();
             assert!(e.contains(needle), "{name}: {e}");
         }
         let spec = Spec {
@@ -536,7 +616,7 @@ mod tests {
 
     #[test]
     fn model_values_reach_both_fmus() {
-        let setup = RunSetup::new(
+        let setup = RunSetup::<2>::new(
             &Spec::default(),
             &[
                 ("model.m[2]".to_string(), 1.2),

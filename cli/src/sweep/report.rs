@@ -19,14 +19,16 @@ pub struct Row {
     pub outcome: Result<Metrics, String>,
 }
 
-/// The metric columns, in CSV order, with their units.
-pub const METRICS: [(&str, &str); 11] = [
+/// The metric columns before the torques, with their units.
+const HEAD: [(&str, &str); 4] = [
     ("time_to_band", "s"),
     ("success", "1/0"),
     ("final_energy_error", "J"),
     ("mean_energy_error", "relative"),
-    ("rms_torque_1", "N m"),
-    ("rms_torque_2", "N m"),
+];
+
+/// The metric columns after the torques, with their units.
+const TAIL: [(&str, &str); 5] = [
     ("distance_to_mode", "rad"),
     ("failed_solves", "samples"),
     ("model_updates", ""),
@@ -34,17 +36,30 @@ pub const METRICS: [(&str, &str); 11] = [
     ("solve_time_p99", "s"),
 ];
 
+/// The metric columns of a robot of `joints` joints, in CSV order, with
+/// their units: one `rms_torque_<j>` per joint.
+pub fn metric_columns(joints: usize) -> Vec<(String, &'static str)> {
+    let torques = (1..=joints).map(|j| (format!("rms_torque_{j}"), "N m"));
+    HEAD.iter()
+        .map(|(n, u)| (n.to_string(), *u))
+        .chain(torques)
+        .chain(TAIL.iter().map(|(n, u)| (n.to_string(), *u)))
+        .collect()
+}
+
 /// The value of metric `name` (NaN when the run has none: never reached
-/// the band, no mode, a failed run).
+/// the band, no mode there, a failed run).
 pub fn metric(m: &Metrics, name: &str) -> Option<f64> {
     let opt = |v: Option<f64>| v.unwrap_or(f64::NAN);
+    if let Some(j) = name.strip_prefix("rms_torque_") {
+        let j: usize = j.parse().ok()?;
+        return m.rms_torque.get(j.checked_sub(1)?).copied();
+    }
     Some(match name {
         "time_to_band" => opt(m.time_to_band),
         "success" => f64::from(u8::from(m.success)),
         "final_energy_error" => m.final_energy_error,
         "mean_energy_error" => m.mean_energy_error,
-        "rms_torque_1" => m.rms_torque[0],
-        "rms_torque_2" => m.rms_torque[1],
         "distance_to_mode" => opt(m.distance_to_mode),
         "failed_solves" => m.failed_solves as f64,
         "model_updates" => m.model_updates as f64,
@@ -54,14 +69,16 @@ pub fn metric(m: &Metrics, name: &str) -> Option<f64> {
     })
 }
 
-/// Checks that `name` is a metric column.
-pub fn check_metric(name: &str) -> Result<(), String> {
-    if METRICS.iter().any(|(m, _)| *m == name) {
+/// Checks that `name` is a metric column for `joints` joints.
+pub fn check_metric(name: &str, joints: usize) -> Result<(), String> {
+    let columns = metric_columns(joints);
+    if columns.iter().any(|(m, _)| m == name) {
         Ok(())
     } else {
+        let names: Vec<&str> = columns.iter().map(|(m, _)| m.as_str()).collect();
         Err(format!(
             "unknown metric `{name}` (known: {})",
-            METRICS.map(|(m, _)| m).join(", ")
+            names.join(", ")
         ))
     }
 }
@@ -76,13 +93,15 @@ fn cell(v: f64) -> String {
     }
 }
 
-/// The CSV: `run`, the swept names, the metrics, `error`.
-pub fn csv(swept: &[String], rows: &[Row]) -> String {
+/// The CSV of a robot of `joints` joints: `run`, the swept names, the
+/// metrics, `error`.
+pub fn csv(swept: &[String], rows: &[Row], joints: usize) -> String {
+    let columns = metric_columns(joints);
     let mut out = String::from("run");
     for n in swept {
         write!(out, ",{n}").unwrap();
     }
-    for (m, _) in METRICS {
+    for (m, _) in &columns {
         write!(out, ",{m}").unwrap();
     }
     out.push_str(",error\n");
@@ -93,7 +112,7 @@ pub fn csv(swept: &[String], rows: &[Row]) -> String {
         }
         match &row.outcome {
             Ok(m) => {
-                for (name, _) in METRICS {
+                for (name, _) in &columns {
                     let v = metric(m, name).unwrap_or(f64::NAN);
                     if v.is_nan() {
                         out.push(',');
@@ -104,7 +123,7 @@ pub fn csv(swept: &[String], rows: &[Row]) -> String {
                 out.push_str(",\n");
             }
             Err(e) => {
-                out.push_str(&",".repeat(METRICS.len()));
+                out.push_str(&",".repeat(columns.len()));
                 // One field: quotes doubled.
                 writeln!(out, ",\"{}\"", e.replace('"', "\"\"")).unwrap();
             }
@@ -168,8 +187,11 @@ pub fn plot(
 }
 
 fn unit_of(metric_name: &str) -> &'static str {
-    METRICS
-        .iter()
+    if metric_name.starts_with("rms_torque_") {
+        return "N m";
+    }
+    HEAD.iter()
+        .chain(TAIL.iter())
         .find(|(m, _)| *m == metric_name)
         .map_or("", |(_, u)| u)
 }

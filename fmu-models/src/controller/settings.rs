@@ -7,8 +7,8 @@ use eigenmpc::adapt::AdaptOptions;
 use eigenmpc::mechanics::{MechanicalSystem, PlanarChain, Vector};
 use eigenmpc::modes::{Chart, ChartFamily, FamilyOptions, linear_modes};
 use eigenmpc::mpc::{
-    Controller, CostParams, EstimatorConfig, MpcConfig, QpBackend, Reference, Variant, Weights,
-    prediction_substeps,
+    Controller, CostParams, EstimatorConfig, Guide, MpcConfig, QpBackend, Reference, Variant,
+    Weights, prediction_substeps,
 };
 
 /// Longest horizon the clarabel QP backend is offered for.
@@ -254,9 +254,10 @@ impl<const N: usize> Settings<N> {
             ));
         }
         let c = c.normalize();
-        match self.variant {
-            Variant::Straight => Ok(Reference::Straight { eigenvector: c }),
-            chart_variant => {
+        Reference::of(
+            self.variant,
+            || Ok(c),
+            || {
                 let chart = Chart::from_coefficients(
                     c,
                     system.equilibrium(),
@@ -273,9 +274,9 @@ impl<const N: usize> Settings<N> {
                          (a chart fitted in s = c'q has 1); pass the c[j] written with the chart"
                     ));
                 }
-                Ok(Reference::with_chart(chart_variant, chart))
-            }
-        }
+                Ok(chart)
+            },
+        )
     }
 
     /// Builds the controller (`NX = 2 N`); the message names what is wrong.
@@ -298,20 +299,21 @@ impl<const N: usize> Settings<N> {
         // A model with Coulomb friction needs RK4 substeps to predict its
         // stiff law near zero speed (1 for a frictionless model).
         config.substeps = prediction_substeps(&system, config.dt);
-        match (self.chart_source, self.variant) {
-            (ChartSource::Parameters, _) => {
+        match self.chart_source {
+            ChartSource::Parameters => {
                 let reference = self.reference(&system)?;
                 Controller::new(system, config, reference).map_err(|e| e.to_string())
             }
-            (ChartSource::Computed, Variant::Straight) => {
-                let eigenvector = self.linear_mode(&system)?;
-                Controller::new(system, config, Reference::Straight { eigenvector })
+            // A chart variant follows the family over E_ref.
+            ChartSource::Computed if self.variant.uses_chart() => {
+                let family = self.family::<NX>(&system)?;
+                Controller::with_family_as(system, config, family, self.variant)
                     .map_err(|e| e.to_string())
             }
-            (ChartSource::Computed, chart_variant) => {
-                let family = self.family::<NX>(&system)?;
-                Controller::with_family_as(system, config, family, chart_variant)
-                    .map_err(|e| e.to_string())
+            ChartSource::Computed => {
+                let eigenvector = self.linear_mode(&system)?;
+                let reference = Reference::new(self.variant, Guide::Line(eigenvector))?;
+                Controller::new(system, config, reference).map_err(|e| e.to_string())
             }
         }
     }

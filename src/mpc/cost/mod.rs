@@ -7,11 +7,50 @@
 //! `r_E = E_ref - E` values a joule gained at a given fraction of the climb
 //! in proportion to `E_ref`, so its weights, tuned at 14 J, pull towards
 //! 3 J with a fifth of that.
+//!
+//! The energy and torque residuals are shared; what differs between the
+//! variants is the distance to the a-priori knowledge, one file each
+//! (`straight.rs`, `curved.rs`, `hybrid.rs`) behind [`CostVariant`], listed
+//! once in the table below.
 
-use super::Variant;
+mod reference;
+mod variant;
+
+pub use reference::{Guide, Reference, ReferenceError};
+pub use variant::{CostVariant, StagePoint, VariantInfo};
+
 use crate::mechanics::{Matrix, MechanicalSystem, Vector, unpack_state};
-use crate::modes::Chart;
 use nalgebra::{SMatrix, SVector};
+use variant::cost_variant_table;
+
+// The cost variants. A new one is a row here and its file (`module.rs`,
+// implementing `CostVariant`): the FMU enumeration, the C constants, the
+// CLI's values and the paper weights follow from the row.
+cost_variant_table! {
+    /// Distance to the linear eigenvector line, blended by `tanh(alpha E)`.
+    Straight in straight {
+        name: "straight",
+        paper_energy_weight: 5.0,
+        uses_chart: false,
+        description: "distance to the linear eigenvector line, blended by tanh(alpha E) (paper eq. 10)",
+    }
+    /// Distance to a precomputed eigenmode chart `X(s)`.
+    Curved in curved {
+        name: "curved",
+        paper_energy_weight: 25.0,
+        uses_chart: true,
+        description: "distance to the eigenmode chart X(s) (paper eq. 12)",
+    }
+    /// The curved distance blended by `tanh(alpha E)` as the straight one
+    /// (the paper's commented-out "Hybrid EigenMPC"): the chart's stiffness
+    /// with some exploration, for a chart of a slightly different model.
+    Hybrid in hybrid {
+        name: "hybrid",
+        paper_energy_weight: 25.0,
+        uses_chart: true,
+        description: "distance to the chart X(s), blended by tanh(alpha E) (paper, Hybrid EigenMPC)",
+    }
+}
 
 /// The paper's weights `W_z = diag(w_E, w_x, w_x, w_xd, w_xd)`, `W_F = w_F I`.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -36,79 +75,6 @@ impl Weights {
             velocity: 2500.0,
             torque: 225.0,
         }
-    }
-}
-
-/// The a-priori knowledge the cost measures distances to.
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub enum Reference<const N: usize> {
-    /// Straight EigenMPC: the unit linear eigenvector `c`.
-    Straight {
-        /// Unit eigenvector of the linearised system.
-        eigenvector: Vector<N>,
-    },
-    /// Curved EigenMPC: a chart of the eigenmode at `E_ref`.
-    Curved(Chart<N>),
-    /// Hybrid EigenMPC: the curved distance to the chart, blended by
-    /// `tanh(alpha E)` as in the straight cost.
-    Hybrid(Chart<N>),
-}
-
-impl<const N: usize> Reference<N> {
-    /// The cost variant this reference selects.
-    pub fn variant(&self) -> Variant {
-        match self {
-            Reference::Straight { .. } => Variant::Straight,
-            Reference::Curved(_) => Variant::Curved,
-            Reference::Hybrid(_) => Variant::Hybrid,
-        }
-    }
-
-    /// The chart of `variant` (curved or hybrid); a straight variant gets
-    /// the chart's linear eigenvector.
-    pub fn with_chart(variant: Variant, chart: Chart<N>) -> Self {
-        match variant {
-            Variant::Straight => Reference::Straight {
-                eigenvector: chart.eigenvector,
-            },
-            Variant::Curved => Reference::Curved(chart),
-            Variant::Hybrid => Reference::Hybrid(chart),
-        }
-    }
-
-    /// The chart the cost follows (curved, hybrid).
-    pub fn chart(&self) -> Option<&Chart<N>> {
-        match self {
-            Reference::Straight { .. } => None,
-            Reference::Curved(chart) | Reference::Hybrid(chart) => Some(chart),
-        }
-    }
-
-    /// The chart, mutable (rewritten in place from a family).
-    pub fn chart_mut(&mut self) -> Option<&mut Chart<N>> {
-        match self {
-            Reference::Straight { .. } => None,
-            Reference::Curved(chart) | Reference::Hybrid(chart) => Some(chart),
-        }
-    }
-
-    /// Checks for non-finite or degenerate data.
-    pub fn validate(&self) -> Result<(), String> {
-        let c = match self {
-            Reference::Straight { eigenvector } => eigenvector,
-            Reference::Curved(chart) | Reference::Hybrid(chart) => {
-                if chart.coefficients.iter().flatten().any(|v| !v.is_finite())
-                    || chart.equilibrium.iter().any(|v| !v.is_finite())
-                {
-                    return Err("chart coefficients must be finite".into());
-                }
-                &chart.eigenvector
-            }
-        };
-        if c.iter().any(|v| !v.is_finite()) || c.norm() < 1e-12 {
-            return Err("the eigenvector must be finite and nonzero".into());
-        }
-        Ok(())
     }
 }
 
@@ -227,79 +193,21 @@ where
         torque_z,
         torque_u: eye,
     };
-    match reference {
-        Reference::Straight { eigenvector } => {
-            let c = eigenvector;
-            let perp = eye - c * c.transpose();
-            r.position = perp * (q - system.equilibrium());
-            r.position_z.fixed_view_mut::<N, N>(0, 0).copy_from(&perp);
-            r.velocity = perp * qd;
-            r.velocity_z.fixed_view_mut::<N, N>(0, N).copy_from(&perp);
-            blend(&mut r, params, energy, &grad_e);
-        }
-        Reference::Curved(chart) => chart_distance(&mut r, chart, &q, &qd),
-        Reference::Hybrid(chart) => {
-            chart_distance(&mut r, chart, &q, &qd);
-            blend(&mut r, params, energy, &grad_e);
-        }
-    }
+    let stage = StagePoint {
+        q,
+        qd,
+        energy,
+        energy_gradient: grad_e,
+    };
+    distance(
+        reference.variant(),
+        &mut r,
+        system,
+        reference.guide(),
+        &stage,
+        params,
+    );
     r
-}
-
-/// The curved distance (paper, eq. 12): position and velocity errors to
-/// the chart point at `s = c'(q - q_eq)`, across the chart's tangent.
-fn chart_distance<const N: usize, const NX: usize>(
-    r: &mut Residuals<N, NX>,
-    chart: &Chart<N>,
-    q: &Vector<N>,
-    qd: &Vector<N>,
-) {
-    let eye = Matrix::<N>::identity();
-    let c0 = chart.eigenvector;
-    let s = chart.coordinate(q);
-    let sd = c0.dot(qd);
-    let p = chart.eval(s);
-    let norm = p.dx.norm().max(1e-12);
-    let c = p.dx / norm;
-    let dc = (p.ddx - c * c.dot(&p.ddx)) / norm;
-    let perp = eye - c * c.transpose();
-    let dperp = -(dc * c.transpose() + c * dc.transpose());
-    let along = eye - p.dx * c0.transpose();
-    let ex = q - p.x;
-    let ev = qd - p.dx * sd;
-    r.position = perp * ex;
-    r.position_z
-        .fixed_view_mut::<N, N>(0, 0)
-        .copy_from(&(perp * along + dperp * ex * c0.transpose()));
-    r.velocity = perp * ev;
-    r.velocity_z
-        .fixed_view_mut::<N, N>(0, 0)
-        .copy_from(&(-(perp * p.ddx) * (sd * c0.transpose()) + dperp * ev * c0.transpose()));
-    r.velocity_z
-        .fixed_view_mut::<N, N>(0, N)
-        .copy_from(&(perp * along));
-}
-
-/// The straight cost's blending (paper, eq. 10): distances times
-/// `1 - tanh(alpha E)`, torque times `tanh(alpha E) + beta`, with the
-/// product rule through `E(z)`.
-fn blend<const N: usize, const NX: usize>(
-    r: &mut Residuals<N, NX>,
-    params: &CostParams,
-    energy: f64,
-    grad_e: &SVector<f64, NX>,
-) {
-    let t = (params.alpha * energy).tanh();
-    let dt_dz = grad_e * (params.alpha * (1.0 - t * t));
-    let g = 1.0 - t;
-    r.position_z = r.position_z * g - r.position * dt_dz.transpose();
-    r.position *= g;
-    r.velocity_z = r.velocity_z * g - r.velocity * dt_dz.transpose();
-    r.velocity *= g;
-    let w = t + params.beta;
-    r.torque_z = r.torque * dt_dz.transpose() + r.torque_z * w;
-    r.torque *= w;
-    r.torque_u = Matrix::<N>::identity() * w;
 }
 
 /// Gauss-Newton model of `scale * l(z, tau)`: value, gradient and Hessian
