@@ -1,8 +1,6 @@
-"""EigenMPC parameter sweeps on Dask: the `eigenmpc sweep` specs run with the
-FMUs under fmpy (see README.md)."""
+"""EigenMPC parameter sweeps on Dask: the `eigenmpc sweep` specs, split into
+parts that Dask workers run with the `eigenmpc` binary (see README.md)."""
 
-from .spec import Spec, expand
-from .closed_loop import METRICS, run_closed_loop
-from .dask_runner import run_sweep, write_results
+from .runner import SweepError, eigenmpc_binary, parts, plan, run_part, run_sweep
 
-__all__ = ["Spec", "expand", "METRICS", "run_closed_loop", "run_sweep", "write_results"]
+__all__ = ["SweepError", "eigenmpc_binary", "parts", "plan", "run_part", "run_sweep"]
