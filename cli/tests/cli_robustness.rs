@@ -92,3 +92,54 @@ fn robustness_refuses_bad_input_with_a_message() {
         assert!(!stderr.contains("panicked"), "{stderr}");
     }
 }
+
+#[test]
+fn a_four_joint_robot_gets_its_report() {
+    let robot = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../robots/examples/four-link-rigid.yml"
+    );
+    let dir = std::env::temp_dir().join(format!("eigenmpc-robustness-4-{}", std::process::id()));
+    let stdout = eigenmpc_ok(&[
+        "robustness",
+        "--model",
+        robot,
+        "--energy",
+        "1",
+        "--tau-max",
+        "2",
+        "--duration",
+        "12",
+        "--steps",
+        "2",
+        "--categories",
+        "measurement delay",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    // No delay: the nominal loop holds 1 J on the friction alone.
+    assert!(
+        stdout.contains("measurement delay: 0.50 -> 0.50"),
+        "{stdout}"
+    );
+    let csv = std::fs::read_to_string(dir.join("robustness.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    assert!(header.contains(&"rms_tau4_Nm") && header.contains(&"rms_friction4_Nm"));
+    assert!(!header.contains(&"rms_tau5_Nm"));
+    let first: Vec<&str> = csv.lines().nth(1).unwrap().split(',').collect();
+    assert_eq!(first.len(), header.len());
+    let cell = |name: &str| first[header.iter().position(|h| *h == name).unwrap()];
+    assert_eq!((cell("value"), cell("success")), ("0", "true"));
+    // Torque on the friction: within the 0.03 N m allowance of it, per joint.
+    for j in 1..=4 {
+        let tau: f64 = cell(&format!("rms_tau{j}_Nm")).parse().unwrap();
+        let friction: f64 = cell(&format!("rms_friction{j}_Nm")).parse().unwrap();
+        assert!(
+            (tau - friction).abs() < 0.005,
+            "joint {j}: {tau} vs {friction}"
+        );
+    }
+    let md = std::fs::read_to_string(dir.join("robustness.md")).unwrap();
+    assert!(md.contains("every joint from 0.05 rad at rest"), "{md}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -125,11 +125,6 @@ impl ModelArgs {
         }
     }
 
-    /// Builds the 2-joint robot (the commands that are the paper's own).
-    pub fn robot(&self) -> anyhow::Result<Robot<2>> {
-        self.robot_of()
-    }
-
     /// Builds the `N`-joint robot, refusing non-physical parameters, bad
     /// files and a file of another joint count.
     pub fn robot_of<const N: usize>(&self) -> anyhow::Result<Robot<N>> {

@@ -55,7 +55,7 @@ fn definitions(sweep: Sweep) -> String {
     format!(
         "One thing differs from the controller's set-up per run, {steps} values per range (ends included). \
          **Model parameters** (the plant; the controller keeps the nominal model): masses, centre-of-mass \
-         distances, inertias about the joint, viscous and Coulomb friction and rotor inertia (both joints \
+         distances, inertias about the joint, viscous and Coulomb friction and rotor inertia (every joint \
          at once), each times 0.75 .. 1.25. An inertia factor that would need a negative inertia about \
          the centre of mass is left out (a point mass has none: the paper's pendulum has only 1 .. 1.25). \
          Friction or rotor inertia that is zero on every joint cannot be scaled: absolute values 0 .. \
@@ -92,8 +92,19 @@ fn definitions(sweep: Sweep) -> String {
     )
 }
 
-/// Runs the sweep and writes the report.
+/// Runs the sweep and writes the report, for the robot's joint count.
 pub fn run(args: &RobustnessArgs) -> anyhow::Result<()> {
+    let n = args.model.joint_count()?;
+    eigenmpc::with_joint_count!(
+        n,
+        |N, S, NP| run_for::<N, S, NP>(args),
+        otherwise Err(anyhow::anyhow!(eigenmpc::joints::unsupported(n)))
+    )
+}
+
+fn run_for<const N: usize, const S: usize, const NP: usize>(
+    args: &RobustnessArgs,
+) -> anyhow::Result<()> {
     if !(args.duration.is_finite() && args.duration > 5.0) {
         bail!(
             "--duration {} must be more than the 5 s scored at the end",
@@ -106,13 +117,13 @@ pub fn run(args: &RobustnessArgs) -> anyhow::Result<()> {
             args.steps
         );
     }
-    let robot = args.model.robot()?;
+    let robot = args.model.robot_of::<N>()?;
     let nominal = *robot.system.params();
     let mut setup = Setup::new(&nominal, args.energy, args.tau_max, args.duration)
         .map_err(anyhow::Error::msg)?;
     setup.ekf = args.ekf;
     // Refuse a configuration the controller cannot build before the sweep.
-    setup.settings.build::<4>().map_err(anyhow::Error::msg)?;
+    setup.settings.build::<S>().map_err(anyhow::Error::msg)?;
     let sweep = Sweep {
         steps: args.steps,
         pulses: args.pulses,
@@ -152,7 +163,7 @@ pub fn run(args: &RobustnessArgs) -> anyhow::Result<()> {
     let outcomes: Vec<_> = pool.install(|| {
         jobs.par_iter()
             .progress_with(bar.clone())
-            .map(|&(i, adapt)| run_case(&setup, &cases[i], 1 + i as u64, adapt))
+            .map(|&(i, adapt)| run_case::<N, S, NP>(&setup, &cases[i], 1 + i as u64, adapt))
             .collect()
     });
     bar.finish_and_clear();
@@ -167,12 +178,13 @@ pub fn run(args: &RobustnessArgs) -> anyhow::Result<()> {
         });
     }
     let title = format!(
-        "# EigenMPC robustness v2: curved, E_ref = {} J, |tau| <= {} N m, N = {}, dt = {} s, {} s per run, from (0.05, 0.05) at rest; model {}{}\n\n{}",
+        "# EigenMPC robustness v2: curved, E_ref = {} J, |tau| <= {} N m, N = {}, dt = {} s, {} s per run, every joint from {} rad at rest; model {}{}\n\n{}",
         args.energy,
         args.tau_max,
         setup.settings.horizon,
         setup.settings.sample_period,
         args.duration,
+        eigenmpc_cli::robustness::START_ANGLE,
         args.model
             .model
             .as_ref()

@@ -14,6 +14,9 @@
 //! 0.03 N m: the energy is held, and held without fighting the plant. The
 //! score of a category is the share of its runs that succeed.
 //!
+//! Any robot of the joint-count table: the per-link categories have one
+//! parameter per link, the pulses act on every joint.
+//!
 //! - this file: the cases and one closed loop per case;
 //! - [`report`]: the Markdown table, the CSV and the plot.
 
@@ -27,9 +30,8 @@ use eigenmpc::mpc::closed_loop::{
 };
 use eigenmpc::robustness::{Imperfections, run_imperfect_disturbed};
 use eigenmpc_fmu_models::chain::ChainParameters;
-use eigenmpc_fmu_models::controller::ControllerProduct;
 use eigenmpc_fmu_models::controller::settings::{Settings, StateEstimator};
-use eigenmpc_fmu_models::products::EigenMpc2;
+use eigenmpc_fmu_models::products::default_settings;
 use nalgebra::SVector;
 
 /// What one case changes against the nominal set-up.
@@ -43,21 +45,21 @@ pub enum Perturbation {
     /// Link `j`'s inertia about its joint times a factor, mass and COM kept
     /// (only factors that leave the inertia about the COM `>= 0` exist).
     Inertia(usize, f64),
-    /// Viscous friction of both joints: `b_j factor + added` (N m s/rad).
+    /// Viscous friction of every joint: `b_j factor + added` (N m s/rad).
     Viscous {
         /// Factor on the nominal value.
         factor: f64,
         /// Added to every joint (for a frictionless robot).
         added: f64,
     },
-    /// Coulomb friction of both joints: `cf_j factor + added` (N m).
+    /// Coulomb friction of every joint: `cf_j factor + added` (N m).
     Coulomb {
         /// Factor on the nominal value.
         factor: f64,
         /// Added to every joint (for a frictionless robot).
         added: f64,
     },
-    /// Rotor inertia of both joints: `Ir_j factor + added` (kg m^2, before
+    /// Rotor inertia of every joint: `Ir_j factor + added` (kg m^2, before
     /// the gearbox).
     RotorInertia {
         /// Factor on the nominal value.
@@ -183,7 +185,11 @@ type MakeJointChange = fn(f64, f64) -> Perturbation;
 
 /// The sweep around `nominal` at torque bound `tau_max` (N m), see the
 /// module documentation; `steps` values per range.
-pub fn default_cases(nominal: &PlanarChainParams<2>, tau_max: f64, sweep: Sweep) -> Vec<Case> {
+pub fn default_cases<const N: usize>(
+    nominal: &PlanarChainParams<N>,
+    tau_max: f64,
+    sweep: Sweep,
+) -> Vec<Case> {
     let factors = sweep.range(0.75, 1.25);
     let mut cases = vec![];
     let mut push = |category, parameter: String, value, unit, perturbation| {
@@ -195,7 +201,7 @@ pub fn default_cases(nominal: &PlanarChainParams<2>, tau_max: f64, sweep: Sweep)
             perturbation,
         })
     };
-    for j in 0..2 {
+    for j in 0..N {
         for &f in &factors {
             push(
                 "mass",
@@ -206,7 +212,7 @@ pub fn default_cases(nominal: &PlanarChainParams<2>, tau_max: f64, sweep: Sweep)
             );
         }
     }
-    for j in 0..2 {
+    for j in 0..N {
         for &f in &factors {
             push(
                 "centre of mass",
@@ -217,7 +223,7 @@ pub fn default_cases(nominal: &PlanarChainParams<2>, tau_max: f64, sweep: Sweep)
             );
         }
     }
-    for j in 0..2 {
+    for j in 0..N {
         let link = nominal.links[j];
         // A point mass has no inertia about its COM to take away.
         let least = link.mass * link.com * link.com / link.inertia_about_joint();
@@ -336,17 +342,18 @@ pub struct TorquePulse {
 }
 
 /// Random torque-pulse profile number `index` for runs of `duration` s at
-/// torque bound `tau_max`: [`PULSES_PER_JOINT`] pulses per joint, each
+/// torque bound `tau_max` on a robot of `joints` joints:
+/// [`PULSES_PER_JOINT`] pulses per joint (joint by joint), each
 /// starting uniformly in [5 s, duration - 15 s] (the loop has settled and
 /// has 10 s to recover before the scored window; all at 5 s for runs of 20
 /// s or less), lasting uniformly [`PULSE_DURATION`], of amplitude uniform
 /// in [-1, 1] x [`MAX_PULSE`] `tau_max`. The generator is seeded with the
 /// index (xorshift: the same profile on every machine).
-pub fn pulse_profile(index: u64, tau_max: f64, duration: f64) -> Vec<TorquePulse> {
+pub fn pulse_profile(index: u64, tau_max: f64, duration: f64, joints: usize) -> Vec<TorquePulse> {
     let mut rng = GaussianNoise::new(0x5eed_0000_0000 + index);
     let (lo, hi) = (5.0, (duration - 15.0).max(5.0));
     let mut pulses = vec![];
-    for joint in 0..2 {
+    for joint in 0..joints {
         for _ in 0..PULSES_PER_JOINT {
             let start = lo + (hi - lo) * rng.uniform();
             let length = PULSE_DURATION.0 + (PULSE_DURATION.1 - PULSE_DURATION.0) * rng.uniform();
@@ -365,8 +372,8 @@ pub fn pulse_profile(index: u64, tau_max: f64, duration: f64) -> Vec<TorquePulse
 /// The disturbance of `pulses` over the sample from `t` (held over the
 /// sample as the motor torque is: a pulse acts on the samples that start
 /// within it).
-pub fn pulse_torque(pulses: &[TorquePulse], t: f64) -> Vector<2> {
-    let mut d = Vector::<2>::zeros();
+pub fn pulse_torque<const N: usize>(pulses: &[TorquePulse], t: f64) -> Vector<N> {
+    let mut d = Vector::<N>::zeros();
     for p in pulses {
         if t >= p.start && t < p.start + p.duration {
             d[p.joint] += p.amplitude;
@@ -377,12 +384,12 @@ pub fn pulse_torque(pulses: &[TorquePulse], t: f64) -> Vector<2> {
 
 /// The plant and the set-up of a case around the nominal model, at sample
 /// period `dt` (s): a delay becomes whole samples plus an exact fraction.
-pub fn plant_and_imperfections(
-    nominal: &PlanarChainParams<2>,
+pub fn plant_and_imperfections<const N: usize>(
+    nominal: &PlanarChainParams<N>,
     perturbation: Perturbation,
     seed: u64,
     dt: f64,
-) -> (PlanarChainParams<2>, Imperfections) {
+) -> (PlanarChainParams<N>, Imperfections) {
     let mut p = *nominal;
     let mut imperfections = Imperfections {
         seed,
@@ -427,11 +434,11 @@ pub fn plant_and_imperfections(
 
 /// The controller configuration every case runs.
 #[derive(Clone, Debug)]
-pub struct Setup {
+pub struct Setup<const N: usize> {
     /// The controller FMU's settings (model = the nominal robot).
-    pub settings: Settings<2>,
-    /// Initial state of every run.
-    pub z0: SVector<f64, 4>,
+    pub settings: Settings<N>,
+    /// Initial angles of every run, at rest (rad).
+    pub q0: Vector<N>,
     /// Simulated time of every run (s).
     pub duration: f64,
     /// The controller filters the measurements with its extended Kalman
@@ -444,22 +451,26 @@ pub struct Setup {
 /// Noise level the filter assumes for a clean sensor (rad, rad/s).
 pub const EKF_NOISE_FLOOR: f64 = 0.005;
 
-impl Setup {
+/// Every joint starts at this angle, at rest (rad): the paper's start.
+pub const START_ANGLE: f64 = 0.05;
+
+impl<const N: usize> Setup<N> {
     /// The controller FMU's default controller (curved, computed family,
-    /// paper tuning) on `nominal` at `e_ref` with `tau_max`.
+    /// paper tuning) on `nominal` at `e_ref` with `tau_max`, every joint
+    /// starting at [`START_ANGLE`].
     pub fn new(
-        nominal: &PlanarChainParams<2>,
+        nominal: &PlanarChainParams<N>,
         e_ref: f64,
         tau_max: f64,
         duration: f64,
     ) -> Result<Self, String> {
-        let mut settings = EigenMpc2::settings(Variant::Curved);
+        let mut settings = default_settings::<N>(Variant::Curved);
         settings.model = ChainParameters::from_params(nominal)?;
         settings.tuning.e_ref = e_ref;
         settings.tau_max = tau_max;
         Ok(Self {
             settings,
-            z0: SVector::<f64, 4>::new(0.05, 0.05, 0.0, 0.0),
+            q0: Vector::<N>::repeat(START_ANGLE),
             duration,
             ekf: false,
         })
@@ -478,9 +489,9 @@ pub struct Outcome {
     /// RMS motor torque over the last 5 s, per joint (N m): the command
     /// after the motor's response, without torque noise or pulses (the
     /// controller's effort, not what the set-up adds to it).
-    pub rms_torque: [f64; 2],
+    pub rms_torque: Vec<f64>,
     /// RMS friction torque of the plant along the last 5 s, per joint (N m).
-    pub friction_torque: [f64; 2],
+    pub friction_torque: Vec<f64>,
     /// The controller ran its extended Kalman filter.
     pub ekf: bool,
     /// Samples whose solve did not succeed.
@@ -493,32 +504,45 @@ pub struct Outcome {
 /// [`ENERGY_TOLERANCE`] of `E_ref` (`energy_error` relative) and, per
 /// joint, the RMS torque at most the friction torque plus
 /// [`TORQUE_ALLOWANCE`]. Anything not finite fails.
-pub fn succeeds(energy_error: f64, rms_torque: [f64; 2], friction_torque: [f64; 2]) -> bool {
+pub fn succeeds(energy_error: f64, rms_torque: &[f64], friction_torque: &[f64]) -> bool {
     energy_error.abs() <= ENERGY_TOLERANCE
-        && (0..2).all(|j| rms_torque[j] <= friction_torque[j] + TORQUE_ALLOWANCE)
+        && rms_torque.len() == friction_torque.len()
+        && rms_torque
+            .iter()
+            .zip(friction_torque)
+            .all(|(tau, friction)| *tau <= friction + TORQUE_ALLOWANCE)
 }
 
 /// RMS per joint of `torque` over the samples of the last `window` s of
 /// `samples` (the window of [`summarise`]).
-fn rms_tail(samples: &[Sample<2, 4>], torque: &[Vector<2>], window: f64) -> [f64; 2] {
+fn rms_tail<const N: usize, const S: usize>(
+    samples: &[Sample<N, S>],
+    torque: &[Vector<N>],
+    window: f64,
+) -> Vec<f64> {
     let t_end = samples.last().map_or(0.0, |s| s.time);
-    let mut sum = [0.0; 2];
+    let mut sum = Vector::<N>::zeros();
     let mut n = 0usize;
     for (s, u) in samples.iter().zip(torque) {
         if s.time > t_end - window + 1e-9 {
-            for j in 0..2 {
-                sum[j] += u[j] * u[j];
-            }
+            sum += u.component_mul(u);
             n += 1;
         }
     }
-    sum.map(|v| (v / n.max(1) as f64).sqrt())
+    sum.iter().map(|v| (v / n.max(1) as f64).sqrt()).collect()
 }
 
 /// Runs one case, with or without adaptation (synchronous: the numbers do
 /// not depend on the machine). A case whose plant or controller cannot be
 /// built, or whose integration fails, is an error.
-pub fn run_case(setup: &Setup, case: &Case, seed: u64, adapt: bool) -> Result<Outcome, String> {
+/// `S = 2 N` and `NP` (the chain's base parameters) as
+/// [`eigenmpc::with_joint_count`] binds them.
+pub fn run_case<const N: usize, const S: usize, const NP: usize>(
+    setup: &Setup<N>,
+    case: &Case,
+    seed: u64,
+    adapt: bool,
+) -> Result<Outcome, String> {
     let nominal = setup.settings.model.params();
     let dt = setup.settings.sample_period;
     let (plant, imperfections) = plant_and_imperfections(&nominal, case.perturbation, seed, dt);
@@ -536,27 +560,30 @@ pub fn run_case(setup: &Setup, case: &Case, seed: u64, adapt: bool) -> Result<Ou
         settings.noise.angle_noise = imperfections.measurement_noise.max(EKF_NOISE_FLOOR);
         settings.noise.speed_noise = imperfections.speed_noise().max(EKF_NOISE_FLOOR);
     }
-    let mut controller = settings.build::<4>()?;
+    let mut controller = settings.build::<S>()?;
     let mut adaptation = if adapt {
         Some(
-            Adaptation::<2, 4, 11>::new(&nominal, settings.adapt_options())
+            Adaptation::<N, S, NP>::new(&nominal, settings.adapt_options())
                 .map_err(|e| e.to_string())?,
         )
     } else {
         None
     };
+    let z0 = SVector::<f64, S>::from_iterator(
+        setup.q0.iter().copied().chain(std::iter::repeat_n(0.0, N)),
+    );
     let pulses = match case.perturbation {
-        Perturbation::TorquePulses(k) => pulse_profile(k, settings.tau_max, setup.duration),
+        Perturbation::TorquePulses(k) => pulse_profile(k, settings.tau_max, setup.duration, N),
         _ => vec![],
     };
     let run = run_imperfect_disturbed(
         &mut controller,
         adaptation.as_mut(),
         &plant,
-        &setup.z0,
+        &z0,
         setup.duration,
         &imperfections,
-        |t| pulse_torque(&pulses, t),
+        |t| pulse_torque::<N>(&pulses, t),
     )
     .map_err(|e| format!("{} = {}: {e}", case.parameter, case.value))?;
     let e_ref = settings.tuning.e_ref;
@@ -565,9 +592,9 @@ pub fn run_case(setup: &Setup, case: &Case, seed: u64, adapt: bool) -> Result<Ou
     let friction = rms_friction_torque(&run.samples, &plant, SCORED_WINDOW);
     let energy_error = (mean - e_ref) / e_ref;
     let rms_torque = rms_tail(&run.samples, &run.motor_torque, SCORED_WINDOW);
-    let friction_torque = [friction[0], friction[1]];
+    let friction_torque: Vec<f64> = friction.iter().copied().collect();
     Ok(Outcome {
-        success: succeeds(energy_error, rms_torque, friction_torque),
+        success: succeeds(energy_error, &rms_torque, &friction_torque),
         time_to_band: summary.time_to_5_percent,
         energy_error,
         rms_torque,
@@ -738,8 +765,13 @@ mod tests {
     #[test]
     fn pulse_profiles_are_seeded_and_bounded() {
         let profiles: Vec<Vec<TorquePulse>> =
-            (1..=50).map(|k| pulse_profile(k, 0.5, 60.0)).collect();
-        assert_eq!(profiles[6], pulse_profile(7, 0.5, 60.0));
+            (1..=50).map(|k| pulse_profile(k, 0.5, 60.0, 2)).collect();
+        assert_eq!(profiles[6], pulse_profile(7, 0.5, 60.0, 2));
+        // Another joint count draws the same first joints' pulses, then more.
+        assert_eq!(
+            pulse_profile(7, 0.5, 60.0, 3)[..2 * PULSES_PER_JOINT],
+            profiles[6][..]
+        );
         assert_ne!(profiles[0], profiles[1]);
         let mut largest: f64 = 0.0;
         for p in profiles.iter().flatten() {
@@ -757,9 +789,9 @@ mod tests {
             duration: 0.1,
             amplitude: -0.2,
         };
-        assert_eq!(pulse_torque(&[p], 0.99), Vector::<2>::zeros());
-        assert_eq!(pulse_torque(&[p], 1.0), Vector::<2>::new(0.0, -0.2));
-        assert_eq!(pulse_torque(&[p], 1.1), Vector::<2>::zeros());
+        assert_eq!(pulse_torque::<2>(&[p], 0.99), Vector::<2>::zeros());
+        assert_eq!(pulse_torque::<2>(&[p], 1.0), Vector::<2>::new(0.0, -0.2));
+        assert_eq!(pulse_torque::<2>(&[p], 1.1), Vector::<2>::zeros());
     }
 
     /// The score rule just inside and just outside each threshold.
@@ -767,13 +799,13 @@ mod tests {
     fn score_rule_thresholds() {
         let friction = [0.05, 0.0];
         let inside = [0.05 + 0.0299, 0.0299];
-        assert!(succeeds(0.0099, inside, friction));
-        assert!(succeeds(-0.0099, inside, friction));
-        assert!(!succeeds(0.0101, inside, friction));
-        assert!(!succeeds(-0.0101, inside, friction));
-        assert!(!succeeds(0.0, [0.05 + 0.0301, 0.0], friction));
-        assert!(!succeeds(0.0, [0.0, 0.0301], friction));
-        assert!(!succeeds(f64::NAN, inside, friction));
-        assert!(!succeeds(0.0, [f64::NAN, 0.0], friction));
+        assert!(succeeds(0.0099, &inside, &friction));
+        assert!(succeeds(-0.0099, &inside, &friction));
+        assert!(!succeeds(0.0101, &inside, &friction));
+        assert!(!succeeds(-0.0101, &inside, &friction));
+        assert!(!succeeds(0.0, &[0.05 + 0.0301, 0.0], &friction));
+        assert!(!succeeds(0.0, &[0.0, 0.0301], &friction));
+        assert!(!succeeds(f64::NAN, &inside, &friction));
+        assert!(!succeeds(0.0, &[f64::NAN, 0.0], &friction));
     }
 }

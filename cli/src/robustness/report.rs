@@ -37,14 +37,18 @@ pub fn score(rows: &[RunPair], category: &str) -> (f64, f64, usize) {
 }
 
 fn outcome_cells(o: &Outcome) -> String {
+    let joints = |v: &[f64], add: f64| {
+        v.iter()
+            .map(|x| format!("{:.3}", x + add))
+            .collect::<Vec<_>>()
+            .join(" / ")
+    };
     format!(
-        "{} | {:+.2} | {:.3} / {:.3} | {:.3} / {:.3} |",
+        "{} | {:+.2} | {} | {} |",
         if o.success { "yes" } else { "**no**" },
         100.0 * o.energy_error,
-        o.rms_torque[0],
-        o.rms_torque[1],
-        o.friction_torque[0] + TORQUE_ALLOWANCE,
-        o.friction_torque[1] + TORQUE_ALLOWANCE,
+        joints(&o.rms_torque, 0.0),
+        joints(&o.friction_torque, TORQUE_ALLOWANCE),
     )
 }
 
@@ -117,16 +121,25 @@ pub fn markdown(title: &str, rows: &[RunPair]) -> String {
     s
 }
 
-/// One CSV row per run and adaptation setting.
+/// One CSV row per run and adaptation setting: `rms_tau<j>_Nm` and
+/// `rms_friction<j>_Nm` per joint.
 pub fn csv(rows: &[RunPair]) -> String {
+    let joints = rows.first().map_or(2, |r| r.off.rms_torque.len());
     let mut s = String::from(
-        "category,parameter,value,unit,adapt,ekf,success,time_to_5pct_band_s,energy_error,rms_tau1_Nm,rms_tau2_Nm,rms_friction1_Nm,rms_friction2_Nm,failed_solves,model_updates\n",
+        "category,parameter,value,unit,adapt,ekf,success,time_to_5pct_band_s,energy_error",
     );
+    for j in 1..=joints {
+        write!(s, ",rms_tau{j}_Nm").unwrap();
+    }
+    for j in 1..=joints {
+        write!(s, ",rms_friction{j}_Nm").unwrap();
+    }
+    s.push_str(",failed_solves,model_updates\n");
     for r in rows {
         for (adapt, o) in [(false, &r.off), (true, &r.on)] {
-            writeln!(
+            write!(
                 s,
-                "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+                "{},{},{},{},{},{},{},{},{}",
                 r.case.category,
                 r.case.parameter,
                 r.case.value,
@@ -136,14 +149,12 @@ pub fn csv(rows: &[RunPair]) -> String {
                 o.success,
                 o.time_to_band.map_or(String::new(), |t| t.to_string()),
                 o.energy_error,
-                o.rms_torque[0],
-                o.rms_torque[1],
-                o.friction_torque[0],
-                o.friction_torque[1],
-                o.failed_solves,
-                o.model_updates
             )
             .unwrap();
+            for v in o.rms_torque.iter().chain(&o.friction_torque) {
+                write!(s, ",{v}").unwrap();
+            }
+            writeln!(s, ",{},{}", o.failed_solves, o.model_updates).unwrap();
         }
     }
     s
@@ -215,7 +226,11 @@ where
 {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| PlotError::new(format!("{e}"));
     root.fill(&WHITE).map_err(err)?;
-    let root = root.titled(title, ("sans-serif", 18)).map_err(err)?;
+    // A caption wider than a few panels gets a smaller font, not clipped
+    // (about half the font size per character).
+    let width = root.dim_in_pixel().0 as f64;
+    let font = (width / (0.52 * title.chars().count().max(1) as f64)).clamp(11.0, 18.0);
+    let root = root.titled(title, ("sans-serif", font)).map_err(err)?;
     let panels = root.split_evenly(grid);
     let off_colour = RGBColor(31, 119, 180);
     let on_colour = RGBColor(255, 127, 14);
