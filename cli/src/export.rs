@@ -9,7 +9,8 @@ use anyhow::{Context, bail};
 use eigenmpc::mechanics::{MechanicalSystem, PlanarChain};
 use eigenmpc::modes::{Family, linear_modes};
 use eigenmpc::mpc::closed_loop::mode_and_chart;
-use eigenmpc_fmu_models::exported::{ExportSpec, RobotExport, SPEC_FILE};
+use eigenmpc_fmu_models::controller::precomputed::FAMILY_FILE;
+use eigenmpc_fmu_models::exported::{ExportSpec, RobotExport, SPEC_FILE, family_resource};
 pub use fmu_build::archive::robot_binary_path;
 use fmu_build::archive::{self, PLATFORM, ROBOT_LIBRARY};
 use fmu_build::ssp::{self, SspSpec};
@@ -81,11 +82,21 @@ pub fn export<const N: usize, const S: usize>(
     }
     .specs()
     .map_err(anyhow::Error::msg)?;
+    // The controller's mode family, computed now so that no instance has
+    // to (0.5 to 2.5 s for 4 to 6 joints at fmi2ExitInitializationMode).
+    let family = family_resource::<N, S>(&controller)
+        .map_err(anyhow::Error::msg)
+        .context("the controller's mode family")?;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let mut paths = vec![];
-    for spec in [&controller, &plant] {
-        let path = write_fmu(out, spec, &binary)?;
-        validate(&path, spec).with_context(|| format!("validating {}", path.display()))?;
+    for (spec, family) in [(&controller, family.as_deref()), (&plant, None)] {
+        let resources: Vec<(&str, &[u8])> = family
+            .map(|f| (FAMILY_FILE, f.as_bytes()))
+            .into_iter()
+            .collect();
+        let path = write_fmu(out, spec, &binary, &resources)?;
+        validate(&path, spec, family.is_some())
+            .with_context(|| format!("validating {}", path.display()))?;
         paths.push(path);
     }
     let ssp = ssp::package(
@@ -162,8 +173,14 @@ pub fn find_binary(given: Option<&Path>) -> anyhow::Result<PathBuf> {
         })
 }
 
-/// Writes `<out>/<model_name>.fmu` of `spec`.
-fn write_fmu(out: &Path, spec: &ExportSpec, binary: &[u8]) -> anyhow::Result<PathBuf> {
+/// Writes `<out>/<model_name>.fmu` of `spec`, with `resources` besides the
+/// spec.
+fn write_fmu(
+    out: &Path,
+    spec: &ExportSpec,
+    binary: &[u8],
+    resources: &[(&str, &[u8])],
+) -> anyhow::Result<PathBuf> {
     let description = spec.description().map_err(anyhow::Error::msg)?;
     let xml = fmi2_slave::xml::model_description_xml(&description);
     let intro = format!(
@@ -174,21 +191,17 @@ fn write_fmu(out: &Path, spec: &ExportSpec, binary: &[u8]) -> anyhow::Result<Pat
     let html = fmi2_slave::xml::documentation_html(&description, &intro);
     let json = serde_json::to_string_pretty(spec)?;
     let path = out.join(format!("{}.fmu", spec.model_name));
-    archive::write_fmu(
-        &path,
-        &spec.model_name,
-        &xml,
-        binary,
-        &html,
-        &[(SPEC_FILE, json.as_bytes())],
-    )?;
+    let mut files = vec![(SPEC_FILE, json.as_bytes())];
+    files.extend_from_slice(resources);
+    archive::write_fmu(&path, &spec.model_name, &xml, binary, &html, &files)?;
     Ok(path)
 }
 
 /// Loads the archive as a host does (unpacked into a temporary folder, the
 /// binary opened, `fmuResourceLocation` a `file:` URI) and runs one second
-/// of co-simulation from the start values.
-fn validate(fmu: &Path, spec: &ExportSpec) -> anyhow::Result<()> {
+/// of co-simulation from the start values; `family`: the controller must
+/// take the mode family of its resources (its log says so).
+fn validate(fmu: &Path, spec: &ExportSpec, family: bool) -> anyhow::Result<()> {
     use fmi2_slave::ffi;
     let dir = std::env::temp_dir().join(format!(
         "eigenmpc-export-{}-{}",
@@ -243,7 +256,7 @@ fn validate(fmu: &Path, spec: &ExportSpec) -> anyhow::Result<()> {
                 uri.as_ptr(),
                 &callbacks,
                 0,
-                0,
+                1,
             );
             if instance.is_null() {
                 let lines: Vec<String> = log.lines().iter().map(|l| l.message.clone()).collect();
@@ -263,6 +276,18 @@ fn validate(fmu: &Path, spec: &ExportSpec) -> anyhow::Result<()> {
                     sym!(fmi2ExitInitializationMode)(instance),
                     "fmi2ExitInitializationMode",
                 )?;
+                let taken = log
+                    .lines()
+                    .iter()
+                    .any(|l| l.message.contains("the one computed at export"));
+                if family && !taken {
+                    let lines: Vec<String> =
+                        log.lines().iter().map(|l| l.message.clone()).collect();
+                    bail!(
+                        "the controller did not take the exported mode family: {}",
+                        lines.join("; ")
+                    );
+                }
                 let step = sym!(fmi2DoStep);
                 for k in 0..40 {
                     ok(step(instance, k as f64 * dt, dt, 1), "fmi2DoStep")?;

@@ -8,7 +8,8 @@
 //! machine: exporting a robot writes files, it builds nothing.
 
 use crate::controller::ControllerFmu;
-use crate::controller::settings::Settings;
+use crate::controller::precomputed::{FAMILY_FILE, PrecomputedFamily};
+use crate::controller::settings::{ChartSource, Settings};
 use crate::plant::PlantFmu;
 use crate::plant::settings::PlantSettings;
 pub use crate::products::{BINARY_NAME, Exported};
@@ -182,9 +183,16 @@ impl Model for ExportedFmu {
         let running: Box<dyn Running> = eigenmpc::with_joint_count!(
             n,
             |N, S, NP| match spec.kind {
-                Kind::Controller => Box::new(ControllerFmu::<Exported, N, S, NP>::initialize(
-                    values, ctx
-                )?),
+                Kind::Controller => {
+                    let defaults = spec.controller_settings::<N>().map_err(ModelError::Error)?;
+                    let family = precomputed_family::<N>(ctx);
+                    Box::new(ControllerFmu::<Exported, N, S, NP>::initialize_with(
+                        values,
+                        ctx,
+                        defaults,
+                        family.as_ref(),
+                    )?)
+                }
                 Kind::Plant => Box::new(PlantFmu::<Exported, N, S>::initialize(values, ctx)?),
             },
             otherwise return Err(ModelError::Error(joints::unsupported(n)))
@@ -218,6 +226,43 @@ impl Model for ExportedFmu {
     fn update_tunables(&mut self, values: &mut Values, ctx: &Context) -> Result<(), ModelError> {
         self.running.update_tunables(values, ctx)
     }
+}
+
+/// The mode family in `resources/` (None: there is none, or it does not
+/// read, which is logged: the controller then computes its own).
+fn precomputed_family<const N: usize>(ctx: &Context) -> Option<PrecomputedFamily<N>> {
+    let path = ctx.resources?.join(FAMILY_FILE);
+    if !path.exists() {
+        return None;
+    }
+    let read = std::fs::read_to_string(&path)
+        .map_err(|e| e.to_string())
+        .and_then(|text| serde_json::from_str(&text).map_err(|e| e.to_string()));
+    match read {
+        Ok(family) => Some(family),
+        Err(e) => {
+            ctx.log.warning(&format!(
+                "{}: {e}; the mode family is computed instead",
+                path.display()
+            ));
+            None
+        }
+    }
+}
+
+/// The mode family of an exported controller `spec`, to ship in its
+/// `resources/` ([`FAMILY_FILE`]): JSON, None when its reference needs none.
+pub fn family_resource<const N: usize, const S: usize>(
+    spec: &ExportSpec,
+) -> Result<Option<String>, String> {
+    let settings = spec.controller_settings::<N>()?;
+    if settings.chart_source != ChartSource::Computed || !settings.variant.uses_chart() {
+        return Ok(None);
+    }
+    let family = PrecomputedFamily::compute::<S>(&settings)?;
+    serde_json::to_string(&family)
+        .map(Some)
+        .map_err(|e| e.to_string())
 }
 
 /// A number for the spec: Integer and enumeration values are integral,
@@ -263,6 +308,14 @@ impl<const N: usize> RobotExport<'_, N> {
         .map(|(name, value)| (name, number(value)))
         .collect();
         controller.insert("tau_max".into(), self.tau_max);
+        // The reference follows E_ref along the mode family, as on the
+        // shipped controllers; the family comes precomputed in resources/
+        // ([`family_resource`]) and the chart at E_ref stays in c / chart
+        // for chart_source = parameters.
+        controller.insert(
+            "chart_source".into(),
+            f64::from(crate::enums::CHART_SOURCE.item(ChartSource::Computed)),
+        );
         let chain = crate::chain::ChainParameters::from_params(self.model)?;
         let plant_settings = PlantSettings::<N> {
             model: chain,

@@ -138,3 +138,30 @@ def test_a_bad_export_is_a_clear_error(eigenmpc_cli, tmp_path):
     bad = run("--model", four, "--out", str(tmp_path), "--binary", str(tmp_path / "none.so"))
     assert bad.returncode == 1 and "no such file" in bad.stderr
     assert not list(tmp_path.iterdir())
+
+
+def test_the_exported_controller_takes_its_precomputed_mode_family(exported, tmp_path):
+    """The family shipped in resources/ is taken as it is (no continuation at
+    fmi2ExitInitializationMode), E_ref then moves along it; a changed model
+    computes its own family and says why."""
+    directory, name, joints = exported["six"]
+    path = str(directory / f"{name}EigenMPC.fmu")
+    md = read_model_description(path)
+    assert float({v.name: v.start for v in md.modelVariables}["chart_source"]) == 1  # computed
+    unzipped = tmp_path / "ctrl"
+    extract(path, unzipdir=str(unzipped))
+    assert (unzipped / "resources" / "eigenmpc-family.json").exists()
+    ctrl = Slave(md, unzipped, "controller", logging_on=True)
+    ctrl.initialize({f"q[{j}]": 0.05 for j in range(1, joints + 1)})
+    assert ctrl.logged("the one computed at export"), ctrl.messages
+    assert not ctrl.logged("computed now")
+    lo, hi = ctrl.get("chart_energy_min", "chart_energy_max")
+    assert lo < 0.5 and hi > 2.0, (lo, hi)
+    ctrl.set_named({"E_ref": 1.5})
+    ctrl.step(DT)
+    assert ctrl.get("chart_energy")[0] == pytest.approx(1.5)
+    ctrl.free()
+    other = Slave(md, unzipped, "lighter", logging_on=True)
+    other.initialize({"m[1]": 0.5})
+    assert other.logged("computed now, not the exported one", "parameters differ"), other.messages
+    other.free()

@@ -2,6 +2,7 @@
 //! what the FMU and the plain C API run every sample, so that both adapt
 //! the same way.
 
+use super::precomputed::PrecomputedFamily;
 use super::settings::{ChainController, Settings};
 use eigenmpc::adapt::{Adaptation, AdaptationEvent, AdaptationState, AdaptationStatus};
 use eigenmpc::identify::BaseParameters;
@@ -27,7 +28,17 @@ impl<const N: usize, const NX: usize, const NP: usize> AdaptiveController<N, NX,
     /// not linear in the base parameters). Set-up: allocates, may take tens
     /// of milliseconds (the mode family).
     pub fn new(settings: &Settings<N>) -> Result<Self, String> {
-        let controller = settings.build::<NX>()?;
+        Self::with_family(settings, None).map(|(c, _)| c)
+    }
+
+    /// [`AdaptiveController::new`] taking `precomputed` as the mode family
+    /// when it fits ([`Settings::build_with`]; the second value says why
+    /// it did not).
+    pub fn with_family(
+        settings: &Settings<N>,
+        precomputed: Option<&PrecomputedFamily<N>>,
+    ) -> Result<(Self, Option<String>), String> {
+        let (controller, refused) = settings.build_with::<NX>(precomputed)?;
         let params = *controller.system().params();
         let prior = BaseParameters::<N, NP>::of(&params).ok();
         let adaptation = if settings.adapt {
@@ -38,11 +49,14 @@ impl<const N: usize, const NX: usize, const NP: usize> AdaptiveController<N, NX,
         } else {
             None
         };
-        Ok(Self {
-            controller,
-            adaptation,
-            prior,
-        })
+        Ok((
+            Self {
+                controller,
+                adaptation,
+                prior,
+            },
+            refused,
+        ))
     }
 
     /// One sample at state `z`, `dt` seconds after the previous one:

@@ -5,7 +5,8 @@
 //! - [`settings`]: the controller definition the table fills in;
 //! - [`timing`]: the sample grid (when to solve);
 //! - [`docs`]: the documentation page's introduction;
-//! - [`start_values`]: the start values of a given robot and reference.
+//! - [`start_values`]: the start values of a given robot and reference;
+//! - [`precomputed`]: a mode family computed ahead (an exported robot's).
 //!
 //! Timing: the controller solves at the communication points that fall on
 //! its sample grid `t_start + k * sample_period` (or, when a grid point falls
@@ -18,6 +19,7 @@
 pub mod adaptive;
 pub mod docs;
 pub mod named;
+pub mod precomputed;
 pub mod settings;
 pub mod start_values;
 pub mod table;
@@ -190,14 +192,19 @@ pub fn description_with<const N: usize>(
     }
 }
 
-impl<P: ControllerProduct<N> + Send, const N: usize, const NX: usize, const NP: usize> Model
-    for ControllerFmu<P, N, NX, NP>
+impl<P: ControllerProduct<N> + Send, const N: usize, const NX: usize, const NP: usize>
+    ControllerFmu<P, N, NX, NP>
 {
-    fn description() -> ModelDescription {
-        description::<P, N>()
-    }
-
-    fn initialize(values: &mut Values, ctx: &Context) -> Result<Self, ModelError> {
+    /// `fmi2ExitInitializationMode` with `defaults` under the values (an
+    /// exported robot's start values; the product's otherwise) and a mode
+    /// family computed ahead, taken when it is the one the settings would
+    /// compute (the log says which).
+    pub fn initialize_with(
+        values: &mut Values,
+        ctx: &Context,
+        defaults: Settings<N>,
+        precomputed: Option<&precomputed::PrecomputedFamily<N>>,
+    ) -> Result<Self, ModelError> {
         let table = table::table::<N>();
         let io = Io::new(&table).map_err(ModelError::Error)?;
         if io.estimate.len() != NP {
@@ -206,7 +213,6 @@ impl<P: ControllerProduct<N> + Send, const N: usize, const NX: usize, const NP: 
                 io.estimate.len()
             )));
         }
-        let defaults = P::settings(Variant::Curved);
         let mut settings = defaults.clone();
         table.read(values, &mut settings, |_| true);
         if settings.chart_source == ChartSource::Computed
@@ -217,7 +223,17 @@ impl<P: ControllerProduct<N> + Send, const N: usize, const NX: usize, const NP: 
                  takes the reference from the model; set chart_source = parameters to use them",
             );
         }
-        let controller = AdaptiveController::new(&settings).map_err(ModelError::Error)?;
+        let (controller, refused) =
+            AdaptiveController::with_family(&settings, precomputed).map_err(ModelError::Error)?;
+        match (precomputed, refused) {
+            (Some(_), None) if controller.controller().family().is_some() => ctx
+                .log
+                .event("mode family: the one computed at export (resources/), not recomputed"),
+            (Some(_), Some(why)) => ctx.log.notice(&format!(
+                "mode family: computed now, not the exported one: {why}"
+            )),
+            _ => {}
+        }
         let mut model = Self {
             controller,
             solved_at: ctx.experiment.start_time,
@@ -235,6 +251,18 @@ impl<P: ControllerProduct<N> + Send, const N: usize, const NX: usize, const NP: 
         model.report_chart(values, ctx);
         model.solve(values, ctx.experiment.start_time, ctx);
         Ok(model)
+    }
+}
+
+impl<P: ControllerProduct<N> + Send, const N: usize, const NX: usize, const NP: usize> Model
+    for ControllerFmu<P, N, NX, NP>
+{
+    fn description() -> ModelDescription {
+        description::<P, N>()
+    }
+
+    fn initialize(values: &mut Values, ctx: &Context) -> Result<Self, ModelError> {
+        Self::initialize_with(values, ctx, P::settings(Variant::Curved), None)
     }
 
     fn do_step(

@@ -2,6 +2,7 @@
 //! its parameters through the variable table) and the plain C API (filled
 //! from its config struct), so both build the controller the same way.
 
+use super::precomputed::PrecomputedFamily;
 use crate::chain::{ChainParameters, HasChain};
 use eigenmpc::adapt::AdaptOptions;
 use eigenmpc::mechanics::{MechanicalSystem, PlanarChain, Vector};
@@ -283,6 +284,17 @@ impl<const N: usize> Settings<N> {
     /// A computed curved reference continues the mode family at creation
     /// (tens of milliseconds for 2 links, see `cargo bench --bench modes`).
     pub fn build<const NX: usize>(&self) -> Result<ChainController<N, NX>, String> {
+        self.build_with::<NX>(None)
+            .map(|(controller, _)| controller)
+    }
+
+    /// [`Settings::build`] taking `precomputed` as its mode family when it
+    /// is the one it would compute. Also returns why a given family was not
+    /// taken (None: taken, or none given, or not needed).
+    pub fn build_with<const NX: usize>(
+        &self,
+        precomputed: Option<&PrecomputedFamily<N>>,
+    ) -> Result<(ChainController<N, NX>, Option<String>), String> {
         if self.qp == QpBackend::Clarabel && self.horizon > CLARABEL_MAX_HORIZON {
             // Its sparse solves grow faster than N: seconds per sample at
             // N = 1000, an unbounded call for a real-time controller.
@@ -302,18 +314,27 @@ impl<const N: usize> Settings<N> {
         match self.chart_source {
             ChartSource::Parameters => {
                 let reference = self.reference(&system)?;
-                Controller::new(system, config, reference).map_err(|e| e.to_string())
+                let c = Controller::new(system, config, reference).map_err(|e| e.to_string())?;
+                Ok((c, None))
             }
             // A chart variant follows the family over E_ref.
             ChartSource::Computed if self.variant.uses_chart() => {
-                let family = self.family::<NX>(&system)?;
-                Controller::with_family_as(system, config, family, self.variant)
-                    .map_err(|e| e.to_string())
+                let (family, refused) = match precomputed {
+                    Some(p) => match p.mismatch(self, &system) {
+                        None => (p.family.clone(), None),
+                        Some(why) => (self.family::<NX>(&system)?, Some(why)),
+                    },
+                    None => (self.family::<NX>(&system)?, None),
+                };
+                let c = Controller::with_family_as(system, config, family, self.variant)
+                    .map_err(|e| e.to_string())?;
+                Ok((c, refused))
             }
             ChartSource::Computed => {
                 let eigenvector = self.linear_mode(&system)?;
                 let reference = Reference::new(self.variant, Guide::Line(eigenvector))?;
-                Controller::new(system, config, reference).map_err(|e| e.to_string())
+                let c = Controller::new(system, config, reference).map_err(|e| e.to_string())?;
+                Ok((c, None))
             }
         }
     }
