@@ -90,6 +90,11 @@ mod tests {
         let mut heavier = settings.clone();
         heavier.model.mass[1] *= 1.1;
         let system = heavier.system().unwrap();
-        assert!(precomputed.mismatch(&heavier, &system).unwrap().contains("parameters"));
+        assert!(
+            precomputed
+                .mismatch(&heavier, &system)
+                .unwrap()
+                .contains("parameters")
+        );
     }
 }

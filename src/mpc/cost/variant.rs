@@ -1,8 +1,8 @@
 //! The machinery behind the variant table in `cost/mod.rs`: what a row says
 //! ([`VariantInfo`]), the interface each variant's file implements
 //! ([`CostVariant`]) and the macro that turns the rows into [`Variant`],
-//! [`VARIANTS`] and the dispatch. The FMU enumeration, the C constants and
-//! the CLI's values are all read from [`VARIANTS`].
+//! [`VARIANTS`](super::VARIANTS) and the dispatch. The FMU enumeration, the C constants and
+//! the CLI's values are all read from [`VARIANTS`](super::VARIANTS).
 
 use super::{CostParams, Guide, Residuals};
 use crate::mechanics::{MechanicalSystem, Vector};
@@ -55,9 +55,9 @@ pub struct VariantInfo {
     pub description: &'static str,
 }
 
-/// Turns the rows of the variant table into the [`Variant`] enum, the
-/// [`VARIANTS`] table (FMU/C items 1, 2, ... in row order: append only) and
-/// the dispatch of [`distance`] to each variant's file.
+/// Turns the rows of the variant table into the `Variant` enum, the
+/// `VARIANTS` table (FMU/C items 1, 2, ... in row order: append only) and
+/// the dispatch of `distance` to each variant's file.
 macro_rules! cost_variant_table {
     ($(
         $(#[doc = $doc:literal])*
