@@ -6,8 +6,9 @@
 //! log line instead of unwinding into the host.
 
 use crate::ffi;
-use crate::instance::{Instance, Model};
+use crate::instance::Instance;
 use crate::logger::{Logger, Status};
+use crate::model::Model;
 use crate::state::{self, FmuState};
 use crate::variables::BaseType;
 use std::any::Any;

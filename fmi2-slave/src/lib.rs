@@ -41,6 +41,7 @@ pub mod abi;
 mod export;
 pub mod instance;
 pub mod logger;
+pub mod model;
 pub mod resources;
 pub mod state;
 pub mod table;
@@ -49,8 +50,9 @@ pub mod values;
 pub mod variables;
 pub mod xml;
 
-pub use instance::{Context, Experiment, Instance, Model, ModelError, State};
+pub use instance::Instance;
 pub use logger::{Category, LOG_CATEGORIES, Logger, Status};
+pub use model::{Context, Experiment, Model, ModelError, State};
 pub use values::Values;
 pub use variables::{
     BaseType, Causality, DefaultExperiment, EnumerationType, Initial, ModelDescription, Unit,

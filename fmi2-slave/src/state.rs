@@ -18,8 +18,7 @@
 //! A buffer from another FMU or another build (GUID), another format
 //! version, or a truncated or corrupt one is refused with the reason.
 
-use crate::instance::ModelError;
-use crate::instance::{Experiment, State};
+use crate::model::{Experiment, ModelError, State};
 use crate::variables::Value;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};

@@ -58,7 +58,7 @@ pub struct MpcConfig {
     pub converge_first_sample: bool,
     /// Converged-SQP settings.
     pub sqp: SqpOptions,
-    /// QP solver built by [`Controller::new`] (default riccati, see docs/results.md).
+    /// QP solver built by [`Controller::new`](super::Controller::new) (default riccati, see docs/results.md).
     pub qp: QpBackend,
     /// State estimator on the measured state (None, the default: the
     /// measurement is used as it is).
