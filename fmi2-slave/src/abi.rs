@@ -9,6 +9,7 @@ use crate::ffi;
 use crate::instance::Instance;
 use crate::logger::{Logger, Status};
 use crate::model::Model;
+use crate::sink::{Fmi2Sink, ToFfi};
 use crate::state::{self, FmuState};
 use crate::variables::BaseType;
 use std::any::Any;
@@ -124,8 +125,7 @@ pub unsafe fn instantiate<M: Model>(
         };
         let name = c_str(instance_name);
         let log = Logger::new(
-            functions.logger,
-            functions.componentEnvironment,
+            Fmi2Sink::boxed(functions.logger, functions.componentEnvironment),
             name.as_deref().unwrap_or(""),
             logging_on != 0,
         );

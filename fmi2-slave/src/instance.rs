@@ -680,11 +680,9 @@ impl<M: Model> Instance<M> {
                 terminate_requested: self.terminate_requested,
                 model,
             };
-            let payload = postcard::to_allocvec(&snapshot)
-                .map_err(|e| format!("{func}: cannot encode the state: {e}"))?;
-            Ok(FmuState {
-                bytes: state::encode(&self.guid, &payload),
-            })
+            let bytes = state::encode_snapshot(&self.guid, &snapshot)
+                .map_err(|e| format!("{func}: {e}"))?;
+            Ok(FmuState { bytes })
         })();
         match r {
             Ok(saved) => {
@@ -703,9 +701,7 @@ impl<M: Model> Instance<M> {
     /// Decodes and checks a serialized state of this FMU (header, payload,
     /// the values against the variable table).
     fn decode_state(&self, bytes: &[u8]) -> Result<(Snapshot, Values), String> {
-        let payload = state::decode(&self.guid, bytes)?;
-        let snapshot: Snapshot =
-            postcard::from_bytes(payload).map_err(|e| format!("malformed state payload: {e}"))?;
+        let snapshot: Snapshot = state::decode_snapshot(&self.guid, bytes)?;
         let values = Values::from_saved(&self.description, &snapshot.values)
             .map_err(|e| format!("malformed state values: {e}"))?;
         let needs_model = matches!(

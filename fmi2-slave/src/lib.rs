@@ -1,20 +1,17 @@
 //! # fmi2-slave
 //!
-//! Generic FMI 2.0 Co-Simulation plumbing, written once and shared by the
-//! EigenMPC FMUs (like the Reference-FMUs' `src/`):
+//! The FMI 2.0 Co-Simulation plumbing, written once and shared by the
+//! EigenMPC FMUs (like the Reference-FMUs' `src/`), on the version-neutral
+//! `fmu-core` (the [`Model`] trait, values, variables, the variable table
+//! and its generators, the state codec, logging and resources; re-exported
+//! here under their old paths):
 //!
-//! - [`variables`]: the variable table ([`ModelDescription`], [`Variable`])
-//!   that drives both value-reference dispatch and `modelDescription.xml`;
-//! - [`instance`]: the state machine (instantiated, initialization mode,
-//!   step complete, step failed, terminated, error), argument checks and the
-//!   [`Model`] trait a model implements;
-//! - [`logger`]: the host's logger callback with the categories
-//!   `logStatusError`, `logStatusWarning`, `logEvents`, `logAll`;
-//! - [`table`]: declarative tables parameterised by the number of joints,
-//!   from which the variables, value references, settings, C constants and
-//!   Markdown tables follow;
-//! - [`resources`]: the `fmuResourceLocation` URI as a folder;
-//! - [`state`]: FMU state save and restore, and its versioned byte form;
+//! - [`instance`]: the FMI 2.0 state machine (instantiated, initialization
+//!   mode, step complete, step failed, terminated, error) and argument
+//!   checks around a [`Model`];
+//! - [`xml`]: `modelDescription.xml` (FMI 2.0 schema), the GUID and the
+//!   documentation page;
+//! - [`sink`]: the host's `fmi2CallbackLogger` as the core logger's sink;
 //! - [`abi`]: the C entry points, generic over the model, with null checks
 //!   and `catch_unwind` (no panic crosses the C ABI);
 //! - [`export_fmi2!`]: generates all 34 FMI 2.0 common + Co-Simulation
@@ -40,24 +37,17 @@ pub mod ffi {
 pub mod abi;
 mod export;
 pub mod instance;
-pub mod logger;
-pub mod model;
-pub mod resources;
-pub mod state;
-pub mod table;
+pub mod sink;
 pub mod testing;
-pub mod values;
-pub mod variables;
 pub mod xml;
 
-pub use instance::Instance;
-pub use logger::{Category, LOG_CATEGORIES, Logger, Status};
-pub use model::{Context, Experiment, Model, ModelError, State};
-pub use values::Values;
-pub use variables::{
-    BaseType, Causality, DefaultExperiment, EnumerationType, Initial, ModelDescription, Unit,
-    Value, VarType, Variability, Variable,
+pub use fmu_core::{
+    BaseType, Category, Causality, Context, DefaultExperiment, EnumerationType, Experiment,
+    Initial, LOG_CATEGORIES, LogSink, Logger, Model, ModelDescription, ModelError, State, Status,
+    Unit, Value, Values, VarType, Variability, Variable,
 };
+pub use fmu_core::{logger, model, resources, state, table, values, variables};
+pub use instance::Instance;
 
 /// Names of the 34 functions every FMI 2.0 Co-Simulation FMU exports.
 pub const FMI2_CS_FUNCTIONS: [&str; 34] = [

@@ -41,7 +41,7 @@ pub const MAX_STATE_BYTES: usize = 64 << 20;
 /// An FMU state handed to the host as `fmi2FMUstate`: its serialized form.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct FmuState {
-    pub(crate) bytes: Vec<u8>,
+    pub bytes: Vec<u8>,
 }
 
 impl FmuState {
@@ -74,7 +74,7 @@ pub fn decode_model<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, ModelError> 
 /// What an instance saves: its state machine, values and time, and the
 /// model's own bytes.
 #[derive(Serialize, Deserialize, Debug)]
-pub(crate) struct Snapshot {
+pub struct Snapshot {
     pub state: State,
     pub values: Vec<Value>,
     pub experiment: Experiment,
@@ -87,15 +87,29 @@ pub(crate) struct Snapshot {
 /// The model part of a snapshot: the values it was initialized from (a
 /// fresh instance rebuilds it from them) and what it saved.
 #[derive(Serialize, Deserialize, Debug, PartialEq)]
-pub(crate) struct ModelSnapshot {
+pub struct ModelSnapshot {
     pub initial_values: Vec<Value>,
     pub state: Vec<u8>,
+}
+
+/// The serialized form of an instance `snapshot` of the FMU with `guid`.
+pub fn encode_snapshot(guid: &str, snapshot: &Snapshot) -> Result<Vec<u8>, String> {
+    let payload =
+        postcard::to_allocvec(snapshot).map_err(|e| format!("cannot encode the state: {e}"))?;
+    Ok(encode(guid, &payload))
+}
+
+/// The instance snapshot of a serialized state of the FMU with `guid`
+/// (header, checksum and payload checked).
+pub fn decode_snapshot(guid: &str, bytes: &[u8]) -> Result<Snapshot, String> {
+    let payload = decode(guid, bytes)?;
+    postcard::from_bytes(payload).map_err(|e| format!("malformed state payload: {e}"))
 }
 
 const HEADER_FIXED: usize = 8 + 4 + 2 + 8 + 4;
 
 /// The serialized form of `payload` for the FMU with `guid`.
-pub(crate) fn encode(guid: &str, payload: &[u8]) -> Vec<u8> {
+pub fn encode(guid: &str, payload: &[u8]) -> Vec<u8> {
     let g = guid.as_bytes();
     let mut out = Vec::with_capacity(HEADER_FIXED + g.len() + payload.len());
     out.extend_from_slice(&MAGIC);
@@ -109,7 +123,7 @@ pub(crate) fn encode(guid: &str, payload: &[u8]) -> Vec<u8> {
 }
 
 /// Checks the header of a serialized state and returns its payload.
-pub(crate) fn decode<'a>(guid: &str, bytes: &'a [u8]) -> Result<&'a [u8], String> {
+pub fn decode<'a>(guid: &str, bytes: &'a [u8]) -> Result<&'a [u8], String> {
     if bytes.len() > MAX_STATE_BYTES {
         return Err(format!(
             "{} bytes is more than the largest FMU state accepted ({MAX_STATE_BYTES})",
@@ -171,19 +185,21 @@ fn live() -> std::sync::MutexGuard<'static, BTreeSet<usize>> {
 }
 
 /// Hands `state` to the host (the pointer is registered as live).
-pub(crate) fn into_raw(state: FmuState) -> *mut FmuState {
+pub fn into_raw(state: FmuState) -> *mut FmuState {
     let p = Box::into_raw(Box::new(state));
     live().insert(p as usize);
     p
 }
 
 /// Whether `p` is a live state of this library.
-pub(crate) fn is_live(p: *const FmuState) -> bool {
+pub fn is_live(p: *const FmuState) -> bool {
     live().contains(&(p as usize))
 }
 
-/// Frees a live state; `false` if `p` is not one.
-pub(crate) fn free(p: *mut FmuState) -> bool {
+/// Frees a live state; `false` if `p` is not one. Safe for any pointer: only
+/// one registered by [`into_raw`] (and not freed since) is dereferenced.
+#[allow(clippy::not_unsafe_ptr_arg_deref)]
+pub fn free(p: *mut FmuState) -> bool {
     if !live().remove(&(p as usize)) {
         return false;
     }

@@ -1,14 +1,21 @@
-//! Logging through the host's `fmi2CallbackLogger`, filtered by the log
-//! categories switched with `fmi2SetDebugLogging`.
+//! Logging to the host, filtered by the log categories the host switches
+//! (`fmi2SetDebugLogging`): the filter is here, the host's callback is a
+//! [`LogSink`] of the FMI version in use (`fmi2_slave::sink`).
 //!
 //! Errors are always reported (they explain an `fmi2Error`). Warnings are
 //! reported while debug logging is off; once a host switches logging on with
 //! an explicit category list, every category (`logStatusWarning`,
 //! `logEvents`, `logAll`) is reported only if listed. `logAll` enables all.
 
-use crate::ffi;
 use std::cell::Cell;
 use std::ffi::CString;
+
+/// Where the messages a [`Logger`] lets through go: the host's logger
+/// callback of one FMI version.
+pub trait LogSink: Send {
+    /// Delivers one message of `instance` (as given at instantiation).
+    fn deliver(&self, instance: &CString, status: Status, category: &str, message: &str);
+}
 
 /// Log categories of the FMU (`<LogCategories>` of the model description).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -75,23 +82,9 @@ pub enum Status {
     Fatal,
 }
 
-impl Status {
-    /// The C value.
-    pub fn to_ffi(self) -> ffi::fmi2Status {
-        match self {
-            Status::Ok => ffi::fmi2Status_fmi2OK,
-            Status::Warning => ffi::fmi2Status_fmi2Warning,
-            Status::Discard => ffi::fmi2Status_fmi2Discard,
-            Status::Error => ffi::fmi2Status_fmi2Error,
-            Status::Fatal => ffi::fmi2Status_fmi2Fatal,
-        }
-    }
-}
-
 /// The host's logger with the instance's category switches.
 pub struct Logger {
-    callback: ffi::fmi2CallbackLogger,
-    environment: ffi::fmi2ComponentEnvironment,
+    sink: Option<Box<dyn LogSink>>,
     instance_name: CString,
     logging_on: bool,
     /// Explicit category list given by the host (`None`: all categories).
@@ -101,22 +94,11 @@ pub struct Logger {
     warned: Cell<bool>,
 }
 
-// SAFETY: the callback and the environment pointer belong to the host, which
-// by the FMI standard may drive an instance from any thread (never from two at
-// once); the logger is only used by the instance that owns it.
-unsafe impl Send for Logger {}
-
 impl Logger {
-    /// A logger calling `callback` (may be absent: then nothing is logged).
-    pub fn new(
-        callback: ffi::fmi2CallbackLogger,
-        environment: ffi::fmi2ComponentEnvironment,
-        instance_name: &str,
-        logging_on: bool,
-    ) -> Self {
+    /// A logger delivering to `sink` (may be absent: then nothing is logged).
+    pub fn new(sink: Option<Box<dyn LogSink>>, instance_name: &str, logging_on: bool) -> Self {
         Self {
-            callback,
-            environment,
+            sink,
             instance_name: to_cstring(instance_name),
             logging_on,
             enabled: None,
@@ -126,7 +108,7 @@ impl Logger {
 
     /// A logger that discards everything (tests of the safe API).
     pub fn silent(instance_name: &str) -> Self {
-        Self::new(None, std::ptr::null_mut(), instance_name, false)
+        Self::new(None, instance_name, false)
     }
 
     /// The instance name.
@@ -162,7 +144,7 @@ impl Logger {
     /// Whether a message of category `c` would reach the host (check before
     /// formatting expensive trace messages).
     pub fn enabled(&self, c: Category) -> bool {
-        if self.callback.is_none() {
+        if self.sink.is_none() {
             return false;
         }
         match c {
@@ -180,23 +162,8 @@ impl Logger {
         if !self.enabled(c) {
             return;
         }
-        let Some(callback) = self.callback else {
-            return;
-        };
-        // The message is the printf format: '%' escaped, no variadic
-        // arguments, so hosts that format and hosts that print the raw
-        // string both show the text.
-        let message = to_cstring(&message.replace('%', "%%"));
-        let category = to_cstring(c.name());
-        // SAFETY: the host promised a valid logger in fmi2Instantiate.
-        unsafe {
-            callback(
-                self.environment,
-                self.instance_name.as_ptr(),
-                status.to_ffi(),
-                category.as_ptr(),
-                message.as_ptr(),
-            );
+        if let Some(sink) = &self.sink {
+            sink.deliver(&self.instance_name, status, c.name(), message);
         }
     }
 
@@ -231,11 +198,12 @@ impl Logger {
     }
 
     /// Clears and returns the "warned during this call" flag.
-    pub(crate) fn take_warned(&self) -> bool {
+    pub fn take_warned(&self) -> bool {
         self.warned.replace(false)
     }
 }
 
-fn to_cstring(s: &str) -> CString {
+/// `s` as a C string (interior NULs become spaces).
+pub fn to_cstring(s: &str) -> CString {
     CString::new(s.replace('\0', " ")).unwrap_or_default()
 }

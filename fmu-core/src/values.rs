@@ -45,17 +45,14 @@ impl Values {
     }
 
     /// All values, in the order of the variable table (FMU state).
-    pub(crate) fn all(&self) -> &[Value] {
+    pub fn all(&self) -> &[Value] {
         &self.values
     }
 
     /// The store of `description` holding `values` (a saved state): each
     /// value must have its variable's type, and parameters and inputs must
     /// pass the variable's checks.
-    pub(crate) fn from_saved(
-        description: &ModelDescription,
-        values: &[Value],
-    ) -> Result<Self, String> {
+    pub fn from_saved(description: &ModelDescription, values: &[Value]) -> Result<Self, String> {
         if values.len() != description.variables.len() {
             return Err(format!(
                 "{} values for {} variables",
