@@ -13,9 +13,9 @@ cargo fmt --all -- --check
 echo "== cargo clippy"
 cargo clippy --workspace --all-targets -- -D warnings
 echo "== the FMUs link only what they run (cargo tree; README \"What each FMU links\")"
-fmu_links() { cargo tree -p "$1" -e normal --prefix none | awk '{print $1}' | sort -u; }
+fmu_links() { cargo tree -p "$1" -e normal,build --prefix none | awk '{print $1}' | sort -u; }
 for p in double-pendulum-fmu triple-pendulum-fmu eigenmpc-fmu eigenmpc3-fmu eigenmpc-robot-fmu; do
-    forbidden='clap|plotters|indicatif|yaml_serde|toml|zip|anyhow|cbindgen|fmi|eigenmpc-cli'
+    forbidden='clap|plotters|indicatif|yaml_serde|toml|zip|anyhow|cbindgen|bindgen|libloading|fmi|eigenmpc-cli'
     case $p in *pendulum*) forbidden="$forbidden|clarabel|faer|rayon|serde_json" ;; esac
     if bad=$(fmu_links "$p" | grep -xE "$forbidden"); then
         echo "$p links what it does not run: $bad" >&2

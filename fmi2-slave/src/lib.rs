@@ -21,8 +21,10 @@
 //! rlib defining them, so this crate defines none: each FMU crate invokes
 //! [`export_fmi2!`] exactly once, and no FMU crate links another.
 
-/// The FMI 2.0 C types and constants (bindgen output of the standard
-/// headers in `fmi-standard2/headers`, see `build.rs`).
+/// The FMI 2.0 C types and constants, and with the feature `loader` the
+/// `Fmi2Binding` that loads a built FMU library (hosts, tests): bindgen output
+/// of the standard headers in `fmi-standard2/headers`, checked in (see
+/// `src/ffi/types.rs`).
 #[allow(
     non_upper_case_globals,
     non_camel_case_types,
@@ -31,7 +33,9 @@
     clippy::all
 )]
 pub mod ffi {
-    include!(concat!(env!("OUT_DIR"), "/fmi2_bindings.rs"));
+    include!("ffi/types.rs");
+    #[cfg(feature = "loader")]
+    include!("ffi/loader.rs");
 }
 
 pub mod abi;
