@@ -7,7 +7,8 @@
 //! plotting and progress-bar crates.
 
 pub mod adaptation;
-pub mod export;
+/// `eigenmpc export` (in fmu-build, which writes the shipped FMUs the same way).
+pub use fmu_build::export;
 pub mod paper;
 pub mod report;
 pub mod robustness;

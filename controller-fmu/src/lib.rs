@@ -1,13 +1,14 @@
-//! # EigenMPC FMU
+//! # EigenMPC C library
 //!
-//! The EigenMPC controller (paper, section IV; `eigenmpc::mpc::Controller`)
-//! for the double pendulum as an FMI 2.0 Co-Simulation FMU, plus a plain C
-//! API ([`capi`]) for embedding the controller without FMI. Both are in the
-//! same shared library (`libeigenmpc_fmu.so`, packaged as `EigenMPC.so`).
-//!
-//! The model, its variable table and its timing are the 2-joint product of
-//! the generic controller in `eigenmpc_fmu_models::controller`; this crate
-//! adds the exported symbols and the C API.
+//! The plain C API ([`capi`]) for embedding the EigenMPC controller (paper,
+//! section IV; `eigenmpc::mpc::Controller`) of any supported joint count
+//! without FMI, in the shared library `libeigenmpc_fmu.so` (header
+//! `include/eigenmpc.h`). The same library exports the FMI 2.0 functions of
+//! the `EigenMPC` model (the 2-joint product of the generic controller in
+//! `eigenmpc_fmu_models::controller`), for C programs that link an FMU's
+//! functions directly. The packaged `EigenMPC.fmu` carries the one FMU
+//! binary (`eigenmpc-robot-fmu`) instead, told by its resources that it is
+//! this model.
 
 pub mod capi;
 mod status;
@@ -27,11 +28,6 @@ pub use status::*;
 
 /// The controller behind the FMU and the C API.
 pub type PendulumController = ChainController<2, 4>;
-
-/// Introduction of the FMU's documentation page.
-pub fn documentation_html() -> String {
-    eigenmpc_fmu_models::controller::docs::documentation_html(2)
-}
 
 /// The 34 FMI 2.0 functions of this FMU.
 pub mod fmi2_exports {

@@ -273,13 +273,15 @@ fn co_simulate<const N: usize, const NX: usize>(
                 .unwrap_or_default();
             let binary = export::robot_binary_path(&args.fmu_dir);
             let source = file.path().display().to_string();
+            let name = export::camel_case(&stem);
+            let family = Family::InPhase;
             let options = export::ExportOptions {
-                name: &export::camel_case(&stem),
+                names: export::PairNames::of_robot(&name, &source, N, &family.to_string()),
+                ssp: &name,
                 energy: args.energy,
-                family: Family::InPhase,
+                family,
                 tau_max,
                 chart_degree: 9,
-                source: &source,
                 binary: &export::find_binary(Some(&binary))?,
             };
             let written = export::export::<N, NX>(&model, &options, &args.out_dir.join("fmu"))?;

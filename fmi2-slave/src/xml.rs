@@ -334,30 +334,3 @@ pub fn documentation_html(d: &ModelDescription, intro_html: &str) -> String {
     writeln!(w, "</ul>\n</body>\n</html>").unwrap();
     h
 }
-
-/// Body of an FMU crate's describe binary: writes `modelDescription.xml` and
-/// `index.html` of model `M` into the directory given as the only argument
-/// (the packaging tool `fmu-build` runs it after the release build).
-pub fn describe_main<M: crate::Model>(intro_html: &str) -> std::process::ExitCode {
-    let args: Vec<String> = std::env::args().collect();
-    let [_, dir] = args.as_slice() else {
-        eprintln!("usage: {} OUT_DIR", args.first().map_or("describe", |s| s));
-        return std::process::ExitCode::FAILURE;
-    };
-    let d = M::description();
-    if let Err(e) = d.validate() {
-        eprintln!("invalid variable table: {e}");
-        return std::process::ExitCode::FAILURE;
-    }
-    let dir = std::path::Path::new(dir);
-    let write = |name: &str, text: String| std::fs::write(dir.join(name), text);
-    match write("modelDescription.xml", model_description_xml(&d))
-        .and_then(|()| write("index.html", documentation_html(&d, intro_html)))
-    {
-        Ok(()) => std::process::ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("cannot write into {}: {e}", dir.display());
-            std::process::ExitCode::FAILURE
-        }
-    }
-}

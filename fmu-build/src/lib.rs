@@ -1,6 +1,10 @@
-//! Packaging shared by `fmu-build` (the shipped FMUs) and `eigenmpc export`
-//! (a user's robot): FMU archives ([`archive`]) and the closed loops as SSP
-//! archives ([`ssp`]).
+//! Packaging shared by `fmu-build` and `eigenmpc export`: FMU archives
+//! ([`archive`]), the closed loops as SSP archives ([`ssp`]), the export of a
+//! robot file as a validated FMU pair ([`export`]) and the pairs this
+//! workspace ships, each an export of a robot file in `robots/`
+//! ([`shipped`]).
 
 pub mod archive;
+pub mod export;
+pub mod shipped;
 pub mod ssp;

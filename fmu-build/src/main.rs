@@ -1,94 +1,63 @@
 //! `fmu-build`: the packaging tool (xtask style).
 //!
-//! `cargo run -p fmu-build` release-builds every FMU crate (one
-//! `cargo build --release -p <crate>` each), writes each FMU's
-//! `modelDescription.xml` from its variable table (also into the checked-in
-//! `modelDescription/`), zips `target/fmu/<modelIdentifier>.fmu`
-//! (`modelDescription.xml`, `binaries/linux64/<modelIdentifier>.so`,
-//! `documentation/index.html`; the binary stripped of debug information,
-//! which is kept apart in `target/fmu/<modelIdentifier>.so.debug`), the
-//! closed loops as SSP archives (`target/fmu/EigenMPC-DoublePendulum.ssp`,
-//! [`ssp`]), generates `include/eigenmpc.h` (the plain C
-//! API with cbindgen, config `cbindgen.toml`, and every FMU's value-reference
-//! and enumeration constants from its variable table) next to the standard
-//! FMI 2.0 headers, and rewrites the README's FMU variable tables from the
-//! variable tables.
+//! `cargo run -p fmu-build` release-builds the one FMU binary
+//! (`eigenmpc-robot-fmu`, stripped; its debug information is kept apart in
+//! `target/fmu/eigenmpc_robot.so.debug`) and writes every shipped pair of
+//! [`SHIPPED`] as an export of its robot file, exactly as `eigenmpc export`
+//! writes a user's robot: `target/fmu/<modelIdentifier>.fmu`
+//! (`modelDescription.xml` from the variable table and the robot,
+//! `binaries/linux64/<modelIdentifier>.so`, `resources/` with what the
+//! instance is and the controller's precomputed mode family,
+//! `documentation/index.html`), each loaded and stepped, and the closed loop
+//! as an SSP archive. It also copies each model description into the
+//! checked-in `modelDescription/`, release-builds the C library
+//! (`libeigenmpc_fmu.so`: the plain C API, [`C_LIBRARY`]), generates
+//! `include/eigenmpc.h` (the C API with cbindgen, config `cbindgen.toml`, and
+//! every shipped FMU's value-reference and enumeration constants from its
+//! variable table) next to the standard FMI 2.0 headers, and rewrites the
+//! README's FMU variable tables from the variable tables.
 //!
-//! Adding an FMU is one entry in [`FMUS`].
+//! Adding a shipped FMU pair is a robot file and one row of [`SHIPPED`].
 
 use fmu_build::archive;
-use fmu_build::ssp;
+use fmu_build::export::{self, ExportOptions};
+use fmu_build::shipped::{SHIPPED, ShippedPair};
 
 use anyhow::{Context, Result, bail};
-use std::path::PathBuf;
+use eigenmpc::model_file::RobotFile;
+use eigenmpc::modes::Family;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// One FMU: its cargo package and what the build produces.
-struct FmuSpec {
-    /// `modelIdentifier` (FMU and shared-library file name).
-    model_identifier: &'static str,
-    /// Cargo package that builds the cdylib.
+/// A library cargo builds: its package and file.
+struct Library {
+    /// Cargo package.
     package: &'static str,
-    /// Package directory relative to the workspace root.
+    /// Package directory relative to the workspace root (cbindgen's input).
     dir: &'static str,
     /// File name of the cdylib cargo writes.
-    library: &'static str,
-    /// Binary of the package that writes modelDescription.xml and index.html.
-    describe: &'static str,
-    /// Prefix of the FMU's constants (value references, enumeration items,
-    /// a C API's constants) in the C header.
-    header_prefix: &'static str,
-    /// Whether the crate has a plain C API for cbindgen.
-    c_api: bool,
-    /// Items that keep their name in the header (a plain C API's types).
-    header_unprefixed: &'static [&'static str],
+    file: &'static str,
 }
 
-/// The FMUs this workspace ships.
-const FMUS: &[FmuSpec] = &[
-    FmuSpec {
-        model_identifier: "DoublePendulum",
-        package: "double-pendulum-fmu",
-        dir: "plant",
-        library: "libdouble_pendulum_fmu.so",
-        describe: "double-pendulum-describe",
-        header_prefix: "DOUBLE_PENDULUM_",
-        c_api: false,
-        header_unprefixed: &[],
-    },
-    FmuSpec {
-        model_identifier: "EigenMPC",
-        package: "eigenmpc-fmu",
-        dir: "controller-fmu",
-        library: "libeigenmpc_fmu.so",
-        describe: "eigenmpc-describe",
-        header_prefix: "EIGENMPC_",
-        c_api: true,
-        // The plain C API (controller-fmu/src/capi.rs) keeps its names.
-        header_unprefixed: &["EigenMpc", "EigenMpcConfig", "EigenMpcStepInfo"],
-    },
-    FmuSpec {
-        model_identifier: "TriplePendulum",
-        package: "triple-pendulum-fmu",
-        dir: "plant3",
-        library: "libtriple_pendulum_fmu.so",
-        describe: "triple-pendulum-describe",
-        header_prefix: "TRIPLE_PENDULUM_",
-        c_api: false,
-        header_unprefixed: &[],
-    },
-    FmuSpec {
-        model_identifier: "EigenMPC3",
-        package: "eigenmpc3-fmu",
-        dir: "controller3-fmu",
-        library: "libeigenmpc3_fmu.so",
-        describe: "eigenmpc3-describe",
-        header_prefix: "EIGENMPC3_",
-        c_api: false,
-        header_unprefixed: &[],
-    },
-];
+/// The one binary of every FMU, shipped or exported.
+const ROBOT: Library = Library {
+    package: "eigenmpc-robot-fmu",
+    dir: "robot-fmu",
+    file: archive::ROBOT_LIBRARY,
+};
 
+/// The plain C library: the C API (`eigenmpc_create`, ...) and the
+/// `EigenMPC` model's FMI functions, for C programs that link it.
+const C_LIBRARY: Library = Library {
+    package: "eigenmpc-fmu",
+    dir: "controller-fmu",
+    file: "libeigenmpc_fmu.so",
+};
+
+/// Items of the C API that keep their name in the header.
+const C_API_UNPREFIXED: &[&str] = &["EigenMpc", "EigenMpcConfig", "EigenMpcStepInfo"];
+/// Prefix of the C API's other items (its constants).
+const C_API_PREFIX: &str = "EIGENMPC_";
 struct Workspace {
     root: PathBuf,
     target: PathBuf,
@@ -124,38 +93,17 @@ fn workspace() -> Result<Workspace> {
     })
 }
 
-fn release_build(ws: &Workspace, fmu: &FmuSpec) -> Result<()> {
-    println!("== cargo build --release -p {}", fmu.package);
+fn release_build(ws: &Workspace, library: &Library) -> Result<()> {
+    println!("== cargo build --release -p {}", library.package);
     let status = Command::new(cargo())
-        .args(["build", "--release", "-p", fmu.package])
+        .args(["build", "--release", "-p", library.package])
         .current_dir(&ws.root)
         .status()
         .context("running cargo build")?;
     if !status.success() {
-        bail!("release build of {} failed", fmu.package);
+        bail!("release build of {} failed", library.package);
     }
     Ok(())
-}
-
-/// Runs the FMU's describe binary; returns (modelDescription.xml, index.html).
-fn describe(ws: &Workspace, fmu: &FmuSpec) -> Result<(String, String)> {
-    let dir = ws
-        .target
-        .join("fmu")
-        .join(format!("{}.sources", fmu.model_identifier));
-    std::fs::create_dir_all(&dir)?;
-    let bin = ws.target.join("release").join(fmu.describe);
-    let status = Command::new(&bin)
-        .arg(&dir)
-        .status()
-        .with_context(|| format!("running {}", bin.display()))?;
-    if !status.success() {
-        bail!("{} failed", bin.display());
-    }
-    Ok((
-        std::fs::read_to_string(dir.join("modelDescription.xml"))?,
-        std::fs::read_to_string(dir.join("index.html"))?,
-    ))
 }
 
 /// The FMU's binary without debug information (the release profile keeps
@@ -195,42 +143,72 @@ fn stripped_binary(ws: &Workspace, library: &str, name: &str) -> Result<Vec<u8>>
     Ok(binary)
 }
 
-fn package(ws: &Workspace, fmu: &FmuSpec, xml: &str, html: &str) -> Result<PathBuf> {
-    let binary = stripped_binary(ws, fmu.library, fmu.model_identifier)?;
-    let path = ws
-        .target
-        .join("fmu")
-        .join(format!("{}.fmu", fmu.model_identifier));
-    archive::write_fmu(&path, fmu.model_identifier, xml, &binary, html, &[])?;
-    Ok(path)
-}
-
 /// The exported robots' binary (`eigenmpc export` copies it into every
 /// FMU it writes), stripped, at [`archive::robot_binary_path`].
 fn robot_binary(ws: &Workspace) -> Result<PathBuf> {
-    let robot = FmuSpec {
-        model_identifier: "eigenmpc_robot",
-        package: "eigenmpc-robot-fmu",
-        dir: "robot-fmu",
-        library: "libeigenmpc_robot.so",
-        describe: "",
-        header_prefix: "",
-        c_api: false,
-        header_unprefixed: &[],
-    };
-    release_build(ws, &robot)?;
-    let binary = stripped_binary(ws, robot.library, robot.model_identifier)?;
+    release_build(ws, &ROBOT)?;
+    let binary = stripped_binary(ws, ROBOT.file, "eigenmpc_robot")?;
     let path = archive::robot_binary_path(&ws.target.join("fmu"));
     std::fs::create_dir_all(path.parent().context("robot binary folder")?)?;
     std::fs::write(&path, binary)?;
     Ok(path)
 }
 
+/// Writes the shipped `pair` into `target/fmu` as `eigenmpc export` would,
+/// from the one binary at `binary`; returns the written archives and the
+/// FMUs' `(modelIdentifier, modelDescription.xml)`.
+fn export_pair(ws: &Workspace, pair: &ShippedPair, binary: &Path) -> Result<Vec<(String, String)>> {
+    let path = ws.root.join(pair.robot);
+    let file = RobotFile::load(&path).with_context(|| format!("{}", path.display()))?;
+    if file.links() != pair.joints {
+        bail!(
+            "{}: {} links, the shipped pair {} has {}",
+            path.display(),
+            file.links(),
+            pair.ssp,
+            pair.joints
+        );
+    }
+    let tau_max = file
+        .torque_limits()
+        .map_or(1.0, |tl| tl.iter().copied().fold(f64::INFINITY, f64::min));
+    let options = ExportOptions {
+        names: pair.names(),
+        ssp: pair.ssp,
+        energy: pair.energy,
+        family: Family::InPhase,
+        tau_max,
+        chart_degree: 9,
+        binary,
+    };
+    let out = ws.target.join("fmu");
+    let n = pair.joints;
+    let written = eigenmpc::with_joint_count!(
+        n,
+        |N, S, NP| export::export::<N, S>(&file.chain::<N>()?, &options, &out)?,
+        otherwise bail!(eigenmpc::joints::unsupported(n))
+    );
+    for path in [&written.controller.1, &written.plant.1, &written.ssp] {
+        println!("wrote {}", path.display());
+    }
+    written
+        .specs
+        .iter()
+        .map(|spec| {
+            let description = spec.description().map_err(anyhow::Error::msg)?;
+            Ok((
+                spec.model_name.clone(),
+                fmi2_slave::xml::model_description_xml(&description),
+            ))
+        })
+        .collect()
+}
+
 /// Updates the checked-in model description; true if it changed.
-fn update_checked_in(ws: &Workspace, fmu: &FmuSpec, xml: &str) -> Result<bool> {
+fn update_checked_in(ws: &Workspace, model_identifier: &str, xml: &str) -> Result<bool> {
     let dir = ws.root.join("modelDescription");
     std::fs::create_dir_all(&dir)?;
-    let path = dir.join(format!("{}.xml", fmu.model_identifier));
+    let path = dir.join(format!("{model_identifier}.xml"));
     let old = std::fs::read_to_string(&path).unwrap_or_default();
     if old == xml {
         return Ok(false);
@@ -257,32 +235,22 @@ fn header(ws: &Workspace) -> Result<PathBuf> {
     }
     let out = include.join("eigenmpc.h");
     let mut text = Vec::new();
-    let mut first = true;
-    for fmu in FMUS.iter().filter(|f| f.c_api) {
+    {
         let mut config = cbindgen::Config::from_file(ws.root.join("cbindgen.toml"))
             .map_err(|e| anyhow::anyhow!("cbindgen.toml: {e}"))?;
-        config.export.prefix = Some(fmu.header_prefix.into());
-        for name in fmu.header_unprefixed {
+        config.export.prefix = Some(C_API_PREFIX.into());
+        for name in C_API_UNPREFIXED {
             config
                 .export
                 .rename
                 .insert(name.to_string(), name.to_string());
         }
         config.export.renaming_overrides_prefixing = true;
-        if !first {
-            // One include guard and preamble for the whole header.
-            config.include_guard = None;
-            config.header = None;
-            config.autogen_warning = None;
-            config.includes.clear();
-            config.no_includes = true;
-        }
-        first = false;
         let bindings = cbindgen::Builder::new()
             .with_config(config)
-            .with_crate(ws.root.join(fmu.dir))
+            .with_crate(ws.root.join(C_LIBRARY.dir))
             .generate()
-            .map_err(|e| anyhow::anyhow!("cbindgen on {}: {e}", fmu.package))?;
+            .map_err(|e| anyhow::anyhow!("cbindgen on {}: {e}", C_LIBRARY.package))?;
         bindings.write(&mut text);
     }
     let mut text = String::from_utf8(text)?;
@@ -292,7 +260,7 @@ fn header(ws: &Workspace) -> Result<PathBuf> {
         .rfind("#endif")
         .context("no include guard in the cbindgen output")?;
     let mut defines = String::from("\n");
-    for fmu in FMUS {
+    for fmu in SHIPPED.iter().flat_map(|p| [&p.plant, &p.controller]) {
         defines.push_str(
             &eigenmpc_fmu_models::products::c_defines(fmu.model_identifier, fmu.header_prefix)
                 .map_err(|e| anyhow::anyhow!(e))?,
@@ -319,27 +287,23 @@ fn update_readme(ws: &Workspace) -> Result<bool> {
 fn main() -> Result<()> {
     let ws = workspace()?;
     std::fs::create_dir_all(ws.target.join("fmu"))?;
-    for fmu in FMUS {
-        release_build(&ws, fmu)?;
-        let (xml, html) = describe(&ws, fmu)?;
-        if update_checked_in(&ws, fmu, &xml)? {
-            println!(
-                "updated modelDescription/{}.xml from the variable table: commit it",
-                fmu.model_identifier
-            );
-        }
-        let path = package(&ws, fmu, &xml, &html)?;
-        println!("wrote {}", path.display());
-    }
     let robot = robot_binary(&ws)?;
     println!(
-        "wrote {} (the binary of `eigenmpc export`)",
+        "wrote {} (the binary of every FMU, shipped or exported)",
         robot.display()
     );
-    for spec in ssp::SSPS {
-        let path = ssp::package(&ws.target.join("fmu"), spec)?;
-        println!("wrote {}", path.display());
+    for pair in SHIPPED {
+        for (model_identifier, xml) in export_pair(&ws, pair, &robot)? {
+            if update_checked_in(&ws, &model_identifier, &xml)? {
+                println!("updated modelDescription/{model_identifier}.xml: commit it");
+            }
+        }
     }
+    release_build(&ws, &C_LIBRARY)?;
+    println!(
+        "built {} (the C API)",
+        ws.target.join("release").join(C_LIBRARY.file).display()
+    );
     let h = header(&ws)?;
     println!("wrote {}", h.display());
     if update_readme(&ws)? {

@@ -22,22 +22,6 @@ pub struct SspSpec<'a> {
     pub joints: usize,
 }
 
-/// The closed loops this workspace ships.
-pub const SSPS: &[SspSpec<'static>] = &[
-    SspSpec {
-        name: "EigenMPC-DoublePendulum",
-        controller: "EigenMPC",
-        plant: "DoublePendulum",
-        joints: 2,
-    },
-    SspSpec {
-        name: "EigenMPC3-TriplePendulum",
-        controller: "EigenMPC3",
-        plant: "TriplePendulum",
-        joints: 3,
-    },
-];
-
 /// Start angle of every joint (rad), at rest: the paper's scenario start.
 pub const START_ANGLE: f64 = 0.05;
 /// Name of the parameter set with the start state (ecos: `init(parameter_set=...)`).
@@ -191,7 +175,8 @@ pub fn package(fmu_dir: &Path, spec: &SspSpec<'_>) -> Result<PathBuf> {
 mod structure_check {
     #[test]
     fn every_state_and_torque_is_connected_once_and_both_fmus_start_at_rest_pose() {
-        for spec in super::SSPS {
+        for pair in crate::shipped::SHIPPED {
+            let spec = &pair.ssp_spec();
             let ssd = super::system_structure(spec);
             let count = |needle: &str| ssd.matches(needle).count();
             assert_eq!(count("<ssd:Component "), 2, "{}", spec.name);

@@ -275,10 +275,52 @@ fn number(value: fmi2_slave::Value) -> f64 {
     }
 }
 
+/// An FMU's `modelName` (and `modelIdentifier`) and one-line description.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Named {
+    /// `modelName` and `modelIdentifier`.
+    pub model_name: String,
+    /// `description`.
+    pub description: String,
+}
+
+/// What the FMUs of an exported pair are called and say.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PairNames {
+    /// The controller FMU.
+    pub controller: Named,
+    /// The plant FMU.
+    pub plant: Named,
+}
+
+impl PairNames {
+    /// `<base>EigenMPC` and `<base>Plant` of an `joints`-joint robot from
+    /// `source` (a file name), whose `family` (e.g. `in-phase`) the
+    /// controller excites: the names `eigenmpc export` gives.
+    pub fn of_robot(base: &str, source: &str, joints: usize, family: &str) -> Self {
+        Self {
+            controller: Named {
+                model_name: format!("{base}EigenMPC"),
+                description: format!(
+                    "EigenMPC controller of the {joints}-joint robot {source}: joint angles and \
+                     speeds in, joint torques out; excites its {family} eigenmode at E_ref"
+                ),
+            },
+            plant: Named {
+                model_name: format!("{base}Plant"),
+                description: format!(
+                    "The {joints}-joint robot {source} as a plant: joint torques in, joint \
+                     angles, speeds and energy out; adaptive Dormand-Prince inside doStep"
+                ),
+            },
+        }
+    }
+}
+
 /// What an exported pair is made of: the robot, its reference and bounds.
 pub struct RobotExport<'a, const N: usize> {
-    /// Base of the FMU names: `<name>EigenMPC` and `<name>Plant`.
-    pub name: &'a str,
+    /// The FMUs' names and descriptions.
+    pub names: &'a PairNames,
     /// The robot (controller's model and plant).
     pub model: &'a eigenmpc::mechanics::PlanarChainParams<N>,
     /// `E_ref` (J).
@@ -289,8 +331,6 @@ pub struct RobotExport<'a, const N: usize> {
     pub chart: &'a [Vec<f64>; N],
     /// Torque bound `tau_max` (N m).
     pub tau_max: f64,
-    /// Where the text says the robot came from (a file name).
-    pub source: &'a str,
 }
 
 impl<const N: usize> RobotExport<'_, N> {
@@ -332,23 +372,15 @@ impl<const N: usize> RobotExport<'_, N> {
             ExportSpec {
                 kind: Kind::Controller,
                 joints: N,
-                model_name: format!("{}EigenMPC", self.name),
-                description: format!(
-                    "EigenMPC controller of the {N}-joint robot {}: joint angles and speeds in, \
-                     joint torques out; excites its in-phase eigenmode at E_ref",
-                    self.source
-                ),
+                model_name: self.names.controller.model_name.clone(),
+                description: self.names.controller.description.clone(),
                 start_values: controller,
             },
             ExportSpec {
                 kind: Kind::Plant,
                 joints: N,
-                model_name: format!("{}Plant", self.name),
-                description: format!(
-                    "The {N}-joint robot {} as a plant: joint torques in, joint angles, speeds \
-                     and energy out; adaptive Dormand-Prince inside doStep",
-                    self.source
-                ),
+                model_name: self.names.plant.model_name.clone(),
+                description: self.names.plant.description.clone(),
                 start_values: plant,
             },
         ];
@@ -368,14 +400,14 @@ mod tests {
     fn a_spec_round_trips_and_describes_its_robot() {
         let model = PlanarChainParams::<4>::point_masses([0.5; 4], [0.4; 4], 9.81);
         let chart: [Vec<f64>; 4] = std::array::from_fn(|_| vec![0.0, 0.5]);
+        let names = PairNames::of_robot("Four", "four.yml", 4, "in-phase");
         let export = RobotExport {
-            name: "Four",
+            names: &names,
             model: &model,
             e_ref: 1.0,
             eigenvector: &[0.5; 4],
             chart: &chart,
             tau_max: 0.7,
-            source: "four.yml",
         };
         let [controller, plant] = export.specs().unwrap();
         let text = serde_json::to_string(&controller).unwrap();

@@ -6,9 +6,13 @@
 //! `modelDescription.xml`, the documentation page, the README tables, the C
 //! header's constants and the start-value files follow.
 //!
-//! This crate exports no symbols: each FMU crate (`controller-fmu`,
-//! `controller3-fmu`, `plant`, `plant3`) picks one product of [`products`]
-//! and invokes `fmi2_slave::export_fmi2!` for it.
+//! This crate exports no symbols: the one FMU binary (`robot-fmu`) invokes
+//! `fmi2_slave::export_fmi2!` for [`exported`]'s model, which is the
+//! controller or the plant of any supported joint count as its resources
+//! say; the C library (`controller-fmu`) for the 2-joint product of
+//! [`products`]. The shipped FMUs are exports of robot files (fmu-build);
+//! [`products`] keeps their names and defaults (the C API's defaults, the
+//! tests).
 //!
 //! - [`enums`]: the `variant` and `qp_solver` enumerations (name, item,
 //!   description), one table used by the FMU and the C API;

@@ -1,6 +1,10 @@
-//! The FMUs this workspace ships: the 2-joint pair `EigenMPC` /
-//! `DoublePendulum` (the paper's) and the 3-link pair `EigenMPC3` /
-//! `TriplePendulum`, each a product of the generic models.
+//! The FMUs this workspace ships as typed products of the generic models:
+//! the 2-joint pair `EigenMPC` / `DoublePendulum` (the paper's) and the
+//! 3-link pair `EigenMPC3` / `TriplePendulum`. The archives are exports of
+//! `robots/paper-double-pendulum.yml` and `robots/three-link-point-masses.yml`
+//! (fmu-build); these products carry the same names, descriptions and
+//! defaults (the checked-in model descriptions' tests hold them equal) for
+//! the C API's defaults, the header's constants and the tests.
 
 use crate::controller::settings::{CHART_COEFFICIENTS, Settings};
 use crate::controller::{ControllerFmu, ControllerProduct};
@@ -27,37 +31,39 @@ pub type DoublePendulumFmu = PlantFmu<DoublePendulumPlant, 2, 4>;
 pub type TriplePendulumFmu = PlantFmu<TriplePendulumPlant, 3, 6>;
 
 /// Unit in-phase eigenvector of the paper's double pendulum
-/// (m = l = 1, g = 9.81): `eigenmpc modes --energies 14`, `linear.eigenvector`.
+/// (m = l = 1, g = 9.81), as the shipped `EigenMPC.fmu` has it: the export of
+/// `robots/paper-double-pendulum.yml` (fmu-build); the checked-in model
+/// description's test holds the two equal.
 pub const DEFAULT_EIGENVECTOR: [f64; 2] = [0.923879532511287, 0.38268343236508934];
 
 /// Chart of the paper's 14 J in-phase eigenmode (degree 9) of the default
-/// model, per joint the coefficients of `s^0..s^9`: pasted from
-/// `eigenmpc modes --energies 14 --fmu-start-values FILE`; a test recomputes
-/// it. (The even powers vanish up to fitting noise: the mode is symmetric.)
+/// model, per joint the coefficients of `s^0..s^9`: pasted from the shipped
+/// `EigenMPC.fmu` (`resources/eigenmpc-export.json`); a test recomputes it.
+/// (The even powers vanish up to fitting noise: the mode is symmetric.)
 pub const DEFAULT_CHART_14J: [[f64; CHART_COEFFICIENTS]; 2] = [
     [
-        -1.5052159046577842e-13,
-        0.5531221059476479,
-        -5.491549575986848e-13,
-        0.9749828065062158,
-        4.2307952497462395e-12,
-        -1.0166322311774332,
-        -6.984272799679647e-12,
-        0.9510679594842322,
-        4.29172769845075e-12,
-        -0.37213572933988365,
+        -1.5025469279328562e-13,
+        0.5531221059476472,
+        -5.52020390092409e-13,
+        0.9749828065062219,
+        4.2256498967141395e-12,
+        -1.0166322311774545,
+        -6.958958105518866e-12,
+        0.9510679594842637,
+        4.272321208480398e-12,
+        -0.37213572933990263,
     ],
     [
-        3.632493802496032e-13,
-        1.2777710399255753,
-        1.3263274688716941e-12,
-        -2.353816714547903,
-        -1.0200914851325364e-11,
-        2.454367320454213,
-        1.6821919178875235e-11,
-        -2.296081166525384,
-        -1.0333171867907603e-11,
-        0.8984151248159734,
+        3.624222414749142e-13,
+        1.277771039925575,
+        1.328069811440726e-12,
+        -2.3538167145479005,
+        -1.0197516310546858e-11,
+        2.454367320454197,
+        1.68143486828595e-11,
+        -2.2960811665253624,
+        -1.033051638967757e-11,
+        0.8984151248159645,
     ],
 ];
 
@@ -65,49 +71,50 @@ pub const DEFAULT_CHART_14J: [[f64; CHART_COEFFICIENTS]; 2] = [
 pub const DEFAULT_E_REF_3: f64 = 14.0;
 
 /// Unit in-phase eigenvector of the default 3-link chain (1 kg point masses
-/// at the tips of 1 m links, g = 9.81), from `eigenmpc::modes::linear_modes`;
-/// a test recomputes it.
+/// at the tips of 1 m links, g = 9.81), as the shipped `EigenMPC3.fmu` has
+/// it (the export of `robots/three-link-point-masses.yml`); a test recomputes
+/// it.
 pub const DEFAULT_EIGENVECTOR_3: [f64; 3] =
-    [0.9127470240857151, 0.26662501734551874, 0.3095221642276576];
+    [0.912747024085715, 0.2666250173455187, 0.30952216422765755];
 
 /// Chart of the default 3-link chain's in-phase eigenmode at 14 J (degree
-/// 9), from `eigenmpc::mpc::closed_loop::mode_and_chart`; a test recomputes it.
+/// 9), pasted from the shipped `EigenMPC3.fmu`; a test recomputes it.
 pub const DEFAULT_CHART_3_14J: [[f64; CHART_COEFFICIENTS]; 3] = [
     [
-        5.050409632079176e-14,
-        0.7530956839278246,
-        -7.221472232102508e-13,
-        0.5136321062655385,
-        -1.79879215790722e-12,
-        0.559172639859015,
-        2.402233659413035e-11,
-        -1.3425680845169263,
-        -3.960358850418949e-11,
-        0.6441743726404677,
+        5.0467210033486056e-14,
+        0.753095683927824,
+        -7.246636525602413e-13,
+        0.5136321062655451,
+        -1.777702708512954e-12,
+        0.5591726398589606,
+        2.3971158981687752e-11,
+        -1.342568084516776,
+        -3.955214027617116e-11,
+        0.6441743726403266,
     ],
     [
-        -2.3983751524207863e-13,
-        0.20744508188041463,
-        1.566399554017458e-12,
-        0.8987682977255529,
-        7.725164771839416e-12,
-        -2.073027942331131,
-        3.9890494726943426e-11,
-        -0.9656515470037538,
-        -1.8760711863298372e-10,
-        2.9219070556767104,
+        -2.394885702016546e-13,
+        0.20744508188041558,
+        1.5557423514756445e-12,
+        0.8987682977255395,
+        7.77642985821277e-12,
+        -2.0730279423310676,
+        3.980244934914225e-11,
+        -0.965651547003892,
+        -1.8754163181564671e-10,
+        2.9219070556768436,
     ],
     [
-        5.742845048831139e-14,
-        0.8312946109385034,
-        7.943879003957048e-13,
-        -2.2888515632061672,
-        -1.4838973629880835e-12,
-        0.13678486710637783,
-        -1.0472469201172058e-10,
-        4.790906938586926,
-        2.7780039892115887e-10,
-        -4.416555319818698,
+        5.746678931782788e-14,
+        0.8312946109385041,
+        7.938060789535489e-13,
+        -2.2888515632061748,
+        -1.4522908752084469e-12,
+        0.13678486710645335,
+        -1.0488934060747302e-10,
+        4.790906938586608,
+        2.7797280291676456e-10,
+        -4.4165553198182845,
     ],
 ];
 

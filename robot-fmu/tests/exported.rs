@@ -7,7 +7,7 @@
 use eigenmpc::model_file::RobotFile;
 use eigenmpc::modes::linear_modes;
 use eigenmpc::mpc::closed_loop::mode_and_chart;
-use eigenmpc_fmu_models::exported::{ExportSpec, ExportedFmu, RobotExport, SPEC_FILE};
+use eigenmpc_fmu_models::exported::{ExportSpec, ExportedFmu, PairNames, RobotExport, SPEC_FILE};
 use eigenmpc_robot::fmi2_exports::*;
 use fmi2_slave::testing::TestInstance;
 use fmi2_slave::{Model, ffi};
@@ -31,13 +31,12 @@ fn export<const N: usize, const S: usize>(file: &Path, energy: f64, dir: &Path) 
     let eigenvector = linear_modes(&system).unwrap()[0].eigenvector;
     let (_, chart) = mode_and_chart::<_, N, S>(&system, 0, energy, 9).unwrap();
     let specs = RobotExport {
-        name: "Robot",
+        names: &PairNames::of_robot("Robot", "test", N, "in-phase"),
         model: system.params(),
         e_ref: energy,
         eigenvector: &std::array::from_fn(|j| eigenvector[j]),
         chart: &chart.coefficients,
         tau_max: 1.0,
-        source: "test",
     }
     .specs()
     .unwrap();

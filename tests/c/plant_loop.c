@@ -1,7 +1,9 @@
 /* C host test of the DoublePendulum FMU: includes the generated header (and
  * through it the standard fmi2Functions.h, so a signature drift fails to
- * compile), links the cdylib, runs a 10 s free swing and checks the energy,
- * then checks that a bad call returns fmi2Error with a log message. */
+ * compile), links the binary of the unpacked archive (the one FMU binary,
+ * told by resources/ that it is this plant), runs a 10 s free swing and
+ * checks the energy, then checks that a bad call returns fmi2Error with a
+ * log message. Arguments: the GUID and the fmuResourceLocation URI. */
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -32,9 +34,9 @@ static void logger(fmi2ComponentEnvironment env, fmi2String name, fmi2Status sta
     } while (0)
 
 int main(int argc, char **argv) {
-    CHECK(argc == 2); /* the GUID from modelDescription.xml */
+    CHECK(argc == 3); /* the GUID from modelDescription.xml, the resources' URI */
     fmi2CallbackFunctions callbacks = {logger, NULL, NULL, NULL, NULL};
-    fmi2Component c = fmi2Instantiate("plant", fmi2CoSimulation, argv[1], "", &callbacks,
+    fmi2Component c = fmi2Instantiate("plant", fmi2CoSimulation, argv[1], argv[2], &callbacks,
                                       fmi2False, fmi2False);
     CHECK(c != NULL);
     const fmi2ValueReference start[] = {DOUBLE_PENDULUM_VR_Q0_1, DOUBLE_PENDULUM_VR_Q0_2};

@@ -7,7 +7,7 @@ use clap::Args;
 use eigenmpc::model_file::RobotFile;
 use eigenmpc::modes::Family;
 use eigenmpc_cli::export::{
-    ExportOptions, camel_case, check_name, default_energy, export, find_binary,
+    ExportOptions, PairNames, camel_case, check_name, default_energy, export, find_binary,
 };
 use std::path::PathBuf;
 
@@ -71,7 +71,7 @@ fn run_for<const N: usize, const S: usize>(
                 .unwrap_or_default(),
         ),
     };
-    check_name(&name)?;
+    check_name(&name).map_err(|e| anyhow::anyhow!("--name {e}"))?;
     let binary = find_binary(args.binary.as_deref())?;
     let system = &robot.system;
     let energy = match args.energy {
@@ -97,12 +97,12 @@ fn run_for<const N: usize, const S: usize>(
         .unwrap_or_default();
     super::prepare_out_dir(&args.out)?;
     let options = ExportOptions {
-        name: &name,
+        names: PairNames::of_robot(&name, &source, N, &family.to_string()),
+        ssp: &name,
         energy,
         family,
         tau_max,
         chart_degree: args.chart_degree,
-        source: &source,
         binary: &binary,
     };
     let written = export::<N, S>(system, &options, &args.out)?;

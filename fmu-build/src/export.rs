@@ -1,25 +1,31 @@
 //! Exporting a robot as a controller FMU, a plant FMU and the SSP that
 //! couples them (`eigenmpc export`, and the demo for joint counts without a
-//! shipped FMU pair), without compiling anything. Both FMUs carry the one
+//! shipped FMU pair), and the shipped FMUs themselves (`fmu-build`: exports
+//! of the robot files in `robots/` under their own names), without compiling
+//! anything. Both FMUs carry the one
 //! prebuilt binary of `eigenmpc-robot-fmu` and tell it what they are in
 //! `resources/eigenmpc-export.json`; each is loaded and stepped before
 //! [`export`] returns.
 
+pub use crate::archive::robot_binary_path;
+use crate::archive::{self, PLATFORM, ROBOT_LIBRARY};
+use crate::ssp::{self, SspSpec};
 use anyhow::{Context, bail};
 use eigenmpc::mechanics::{MechanicalSystem, PlanarChain};
 use eigenmpc::modes::{Family, linear_modes};
 use eigenmpc::mpc::closed_loop::mode_and_chart;
 use eigenmpc_fmu_models::controller::precomputed::FAMILY_FILE;
-use eigenmpc_fmu_models::exported::{ExportSpec, RobotExport, SPEC_FILE, family_resource};
-pub use fmu_build::archive::robot_binary_path;
-use fmu_build::archive::{self, PLATFORM, ROBOT_LIBRARY};
-use fmu_build::ssp::{self, SspSpec};
+use eigenmpc_fmu_models::exported::{ExportSpec, Kind, RobotExport, SPEC_FILE, family_resource};
+pub use eigenmpc_fmu_models::exported::{Named, PairNames};
 use std::path::{Path, PathBuf};
 
 /// What to export.
 pub struct ExportOptions<'a> {
-    /// Base of the FMU names (`<name>EigenMPC`, `<name>Plant`, `<name>.ssp`).
-    pub name: &'a str,
+    /// The FMUs' names and descriptions ([`PairNames::of_robot`] for a
+    /// user's robot).
+    pub names: PairNames,
+    /// The SSP archive's name (`<ssp>.ssp`).
+    pub ssp: &'a str,
     /// `E_ref` (J) and the energy of the controller's chart.
     pub energy: f64,
     /// The mode family of the chart.
@@ -28,8 +34,6 @@ pub struct ExportOptions<'a> {
     pub tau_max: f64,
     /// Degree of the chart polynomials.
     pub chart_degree: usize,
-    /// Where the robot came from (a file name), for the descriptions.
-    pub source: &'a str,
     /// The exported robots' FMU binary.
     pub binary: &'a Path,
 }
@@ -42,6 +46,8 @@ pub struct Exported {
     pub plant: (String, PathBuf),
     /// The SSP archive.
     pub ssp: PathBuf,
+    /// What each FMU is: the controller's and the plant's specs.
+    pub specs: [ExportSpec; 2],
 }
 
 /// The default energy of an export: 10 % of the potential energy with every
@@ -59,7 +65,9 @@ pub fn export<const N: usize, const S: usize>(
     options: &ExportOptions<'_>,
     out: &Path,
 ) -> anyhow::Result<Exported> {
-    check_name(options.name)?;
+    for named in [&options.names.controller, &options.names.plant] {
+        check_name(&named.model_name).context("FMU name")?;
+    }
     let binary = std::fs::read(options.binary)
         .with_context(|| format!("reading {}", options.binary.display()))?;
     let family = options.family;
@@ -72,13 +80,12 @@ pub fn export<const N: usize, const S: usize>(
         mode_and_chart::<_, N, S>(system, family.index(), energy, options.chart_degree)
             .with_context(|| format!("{family} eigenmode at {energy} J"))?;
     let [controller, plant] = RobotExport {
-        name: options.name,
+        names: &options.names,
         model: system.params(),
         e_ref: energy,
         eigenvector: &std::array::from_fn(|j| eigenvector[j]),
         chart: &chart.coefficients,
         tau_max: options.tau_max,
-        source: options.source,
     }
     .specs()
     .map_err(anyhow::Error::msg)?;
@@ -102,7 +109,7 @@ pub fn export<const N: usize, const S: usize>(
     let ssp = ssp::package(
         out,
         &SspSpec {
-            name: options.name,
+            name: options.ssp,
             controller: &controller.model_name,
             plant: &plant.model_name,
             joints: N,
@@ -111,9 +118,10 @@ pub fn export<const N: usize, const S: usize>(
     let plant_path = paths.pop().context("plant archive")?;
     let controller_path = paths.pop().context("controller archive")?;
     Ok(Exported {
-        controller: (controller.model_name, controller_path),
-        plant: (plant.model_name, plant_path),
+        controller: (controller.model_name.clone(), controller_path),
+        plant: (plant.model_name.clone(), plant_path),
         ssp,
+        specs: [controller, plant],
     })
 }
 
@@ -131,14 +139,13 @@ pub fn camel_case(stem: &str) -> String {
         .collect()
 }
 
-/// A name usable as `modelIdentifier` (C identifier, file name).
+/// A name usable as `modelIdentifier` (C identifier, file name); the
+/// error quotes the name (the caller says which name it is).
 pub fn check_name(name: &str) -> anyhow::Result<()> {
     let ok = name.chars().next().is_some_and(|c| c.is_ascii_alphabetic())
         && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
     if !ok {
-        bail!(
-            "--name '{name}': an FMU name starts with a letter and has only letters, digits and _"
-        );
+        bail!("'{name}': an FMU name starts with a letter and has only letters, digits and _");
     }
     Ok(())
 }
@@ -183,9 +190,15 @@ fn write_fmu(
 ) -> anyhow::Result<PathBuf> {
     let description = spec.description().map_err(anyhow::Error::msg)?;
     let xml = fmi2_slave::xml::model_description_xml(&description);
+    let kind = match spec.kind {
+        Kind::Controller => eigenmpc_fmu_models::controller::docs::documentation_html(spec.joints),
+        Kind::Plant => eigenmpc_fmu_models::plant::docs::documentation_html(spec.joints),
+    };
     let intro = format!(
-        "<p>{}</p><p>Exported by <code>eigenmpc export</code>: the robot's parameters are this \
-         FMU's start values; <code>resources/{SPEC_FILE}</code> tells the binary what it is.</p>",
+        "<p>{}</p>{kind}<p><b>Export.</b> Written by <code>eigenmpc export</code> (the shipped \
+         FMUs by <code>fmu-build</code>, from the robot files in <code>robots/</code>): the \
+         robot's parameters are this FMU's start values; <code>resources/{SPEC_FILE}</code> \
+         tells the one FMU binary what it is.</p>",
         fmi2_slave::xml::escape(&spec.description)
     );
     let html = fmi2_slave::xml::documentation_html(&description, &intro);

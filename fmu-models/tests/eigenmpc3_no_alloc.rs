@@ -6,8 +6,13 @@
 
 use eigenmpc::integrate::rk4_step;
 use eigenmpc::mechanics::{PlanarChain, Vector};
-use eigenmpc3_fmu::EigenMpc3Fmu;
-use eigenmpc3_fmu::fmi2_exports::*;
+/// The FMU's C functions over the model, as the FMU binary exports them
+/// (one model per test binary: the symbols are unmangled).
+mod fmi2_exports {
+    fmi2_slave::export_fmi2!(eigenmpc_fmu_models::products::EigenMpc3Fmu);
+}
+use eigenmpc_fmu_models::products::EigenMpc3Fmu;
+use fmi2_exports::*;
 use fmi2_slave::testing::TestInstance;
 use fmi2_slave::{Model, ffi};
 use nalgebra::SVector;

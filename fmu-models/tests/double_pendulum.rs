@@ -1,13 +1,17 @@
 //! The DoublePendulum FMU through its FMI 2.0 C functions: physics (energy
 //! conservation, work of the torque, damping), independence from the
-//! communication step, parameter checks, the checked-in model description,
-//! and the built shared library (exported symbols, dynamic loading).
+//! communication step, parameter checks, the checked-in model description.
+//! (The FMU binary's symbols and loading: robot-fmu's tests.)
 
-use double_pendulum_fmu::fmi2_exports::*;
-use double_pendulum_fmu::*;
-use fmi2_slave::testing::{LogCapture, TestInstance};
+/// The FMU's C functions over the model, as the FMU binary exports them
+/// (one model per test binary: the symbols are unmangled).
+mod fmi2_exports {
+    fmi2_slave::export_fmi2!(eigenmpc_fmu_models::products::DoublePendulumFmu);
+}
+use eigenmpc_fmu_models::products::DoublePendulumFmu;
+use fmi2_exports::*;
+use fmi2_slave::testing::TestInstance;
 use fmi2_slave::{Model, ffi, xml};
-use std::ffi::CString;
 use std::path::PathBuf;
 use std::ptr;
 
@@ -245,63 +249,6 @@ fn invalid_parameters_and_inputs_are_rejected() {
             .log
             .contains(&["energy (value reference 6, causality Output"])
     );
-}
-
-/// The plant's cdylib built for this test run.
-fn library() -> PathBuf {
-    fmi2_slave::testing::test_cdylib("double_pendulum_fmu")
-}
-
-#[test]
-fn shared_library_exports_all_34_functions() {
-    fmi2_slave::testing::assert_exports_fmi2_cs(&library());
-}
-
-#[test]
-fn loaded_library_runs_like_the_linked_model() {
-    // dlopen the cdylib as a host does and compare with the in-process run.
-    let lib = unsafe { ffi::Fmi2Binding::new(library()) }.expect("load the FMU library");
-    let log = LogCapture::new();
-    let callbacks = log.callbacks();
-    let name = CString::new("loaded").unwrap();
-    let guid = CString::new(xml::guid(&DoublePendulumFmu::description())).unwrap();
-    let mut linked = Fmu::start(&swing());
-    unsafe {
-        let instantiate = lib.fmi2Instantiate.as_ref().unwrap();
-        let c = instantiate(
-            name.as_ptr(),
-            1,
-            guid.as_ptr(),
-            ptr::null(),
-            &callbacks,
-            0,
-            0,
-        );
-        assert!(!c.is_null());
-        let set = lib.fmi2SetReal.as_ref().unwrap();
-        for (vr, v) in swing() {
-            assert_eq!(set(c, &vr, 1, &v), OK);
-        }
-        assert_eq!(lib.fmi2EnterInitializationMode.as_ref().unwrap()(c), OK);
-        assert_eq!(lib.fmi2ExitInitializationMode.as_ref().unwrap()(c), OK);
-        let step = lib.fmi2DoStep.as_ref().unwrap();
-        let mut t = 0.0;
-        for _ in 0..100 {
-            assert_eq!(step(c, t, 0.01, 1), OK);
-            t += 0.01;
-            linked.step(0.01);
-        }
-        let mut v = [0.0; 5];
-        assert_eq!(
-            lib.fmi2GetReal.as_ref().unwrap()(c, outputs_vr().as_ptr(), 5, v.as_mut_ptr()),
-            OK
-        );
-        assert_eq!(v, linked.outputs());
-        // an error through the loaded library is logged and reported
-        assert_eq!(step(c, 5.0, 0.01, 1), ERROR);
-        assert!(log.contains(&["differs from the FMU's time"]));
-        lib.fmi2FreeInstance.as_ref().unwrap()(c);
-    }
 }
 
 #[test]
