@@ -8,11 +8,11 @@ cd "$(dirname "$0")/.."
 # apt_install and the build's Debian packages (libclang-dev, binutils, gcc).
 source scripts/ensure-build-deps.sh
 
-echo "== cargo fmt --check"
+echo "== [${SECONDS} s] cargo fmt --check"
 cargo fmt --all -- --check
-echo "== cargo clippy"
+echo "== [${SECONDS} s] cargo clippy"
 cargo clippy --workspace --all-targets -- -D warnings
-echo "== the FMUs link only what they run (cargo tree; README \"What each FMU links\")"
+echo "== [${SECONDS} s] the FMUs link only what they run (cargo tree; README \"What each FMU links\")"
 fmu_links() { cargo tree -p "$1" -e normal,build --prefix none | awk '{print $1}' | sort -u; }
 # The one FMU binary (every shipped and exported FMU) and the C library.
 for p in eigenmpc-robot-fmu eigenmpc-fmu; do
@@ -22,12 +22,12 @@ for p in eigenmpc-robot-fmu eigenmpc-fmu; do
         exit 1
     fi
 done
-echo "== cargo test"
+echo "== [${SECONDS} s] cargo test"
 cargo test --workspace
-echo "== fmu-build (release cdylibs, target/fmu/*.fmu, include/eigenmpc.h)"
+echo "== [${SECONDS} s] fmu-build (release cdylibs, target/fmu/*.fmu, include/eigenmpc.h)"
 cargo run -p fmu-build
 
-echo "== demo (the main job, on the FMUs just built): controller FMU drives plant FMU"
+echo "== [${SECONDS} s] demo (the main job, on the FMUs just built): controller FMU drives plant FMU"
 bash demo/run.sh --no-build --out-dir target/demo-ci
 for f in demo.csv demo.png demo.svg; do
     test -s "target/demo-ci/$f" || { echo "demo did not write target/demo-ci/$f" >&2; exit 1; }
@@ -51,7 +51,7 @@ if bash demo/run.sh --no-build --links 4 --out-dir target/demo-ci-4 2>/dev/null;
     exit 1
 fi
 
-echo "== C host tests (gcc, include/eigenmpc.h, linked FMU libraries)"
+echo "== [${SECONDS} s] C host tests (gcc, include/eigenmpc.h, linked FMU libraries)"
 target_dir=${CARGO_TARGET_DIR:-target}
 # The shipped DoublePendulum.fmu unpacked: its binary linked, its resources
 # telling the binary what it is.
@@ -69,7 +69,7 @@ gcc -std=c11 -Wall -Wextra -Werror -Iinclude tests/c/controller_loop.c \
     -lm -o "$target_dir/controller_loop"
 "$target_dir/controller_loop"
 
-echo "== Python test environment (.venv)"
+echo "== [${SECONDS} s] Python test environment (.venv)"
 if [ ! -x .venv/bin/python ]; then
     # Debian's python3 lacks ensurepip until python3-venv is installed.
     if ! python3 -c "import ensurepip, venv" >/dev/null 2>&1; then
@@ -112,9 +112,9 @@ if [ "$(cat "$sweep_stamp" 2>/dev/null)" != "$want" ]; then
     .venv/bin/pip install -q --disable-pip-version-check -e python
     echo "$want" >"$sweep_stamp"
 fi
-echo "== release CLI (the Python tests compare with \`eigenmpc simulate\`)"
+echo "== [${SECONDS} s] release CLI (the Python tests compare with \`eigenmpc simulate\`)"
 cargo build --release --bin eigenmpc
-echo "== pytest"
+echo "== [${SECONDS} s] pytest"
 .venv/bin/python -m pytest tests/python -rs
-echo "== pytest python/ (the Dask sweep runner against the native sweep)"
+echo "== [${SECONDS} s] pytest python/ (the Dask sweep runner against the native sweep)"
 .venv/bin/python -m pytest python/tests -rs
