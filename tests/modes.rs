@@ -135,7 +135,9 @@ fn bad_requests_give_errors() {
         &ContinuationOptions::default(),
     );
     assert!(matches!(r, Err(ModeError::NoSuchMode { index: 2, dof: 2 })));
-    // Beyond the top of the potential (V <= 58.86 J) no brake orbit exists.
+    // Beyond the top of the potential (V <= 58.86 J) no brake orbit exists;
+    // towards it the period grows without bound, and the continuation ends
+    // at its work limit or where Newton fails, whichever comes first.
     match family(Family::InPhase, &[70.0]) {
         Err(ModeError::ContinuationFailed {
             reached, requested, ..
@@ -143,6 +145,57 @@ fn bad_requests_give_errors() {
             assert_eq!(requested, 70.0);
             assert!(reached > 14.0 && reached < 70.0, "reached {reached}");
         }
+        Err(ModeError::WorkLimit { reached, .. }) => {
+            assert!(reached > 50.0 && reached < 58.86, "reached {reached}");
+        }
         other => panic!("expected a continuation failure, got {other:?}"),
     }
+}
+
+/// The work limit stops a continuation with a message naming it, and the
+/// work it bounds is what the default allows a normal family many times
+/// over: the 14 J in-phase orbit of the paper's pendulum needs well under a
+/// tenth of it, and a budget too small for the first orbit stops at once.
+#[test]
+fn the_work_limit_stops_the_continuation_and_says_so() {
+    let sys = DoublePendulum::default();
+    let opts = ContinuationOptions::default();
+    assert!(opts.max_evaluations >= 1_000_000);
+    let run = |max_evaluations| {
+        eigenmode_family::<_, 2, 4>(
+            &sys,
+            Family::InPhase.index(),
+            &[14.0],
+            &ContinuationOptions {
+                max_evaluations,
+                ..opts
+            },
+        )
+    };
+    assert!(run(opts.max_evaluations / 10).is_ok());
+    match run(2_000) {
+        Err(ModeError::WorkLimit { limit, reached, .. }) => {
+            assert_eq!(limit, 2_000);
+            assert!(reached < 14.0);
+        }
+        other => panic!("expected the work limit, got {other:?}"),
+    }
+    let message = run(50_000).unwrap_err().to_string();
+    assert!(
+        message.contains("work limit (50000 integrator evaluations)"),
+        "{message}"
+    );
+    // A very light first link (the FMU's declared minimum mass): the time
+    // scales are far apart, and the default limit ends it, fast.
+    let light = eigenmpc::mechanics::PlanarChain::<2>::new(
+        eigenmpc::mechanics::PlanarChainParams::point_masses([1e-6, 1.0], [1.0, 1.0], 9.81),
+    )
+    .unwrap();
+    let start = std::time::Instant::now();
+    let outcome = eigenmode_family::<_, 2, 4>(&light, 0, &[14.0], &opts);
+    println!("light first link: {outcome:?} in {:?}", start.elapsed());
+    assert!(
+        matches!(outcome, Err(ModeError::WorkLimit { .. })),
+        "{outcome:?}"
+    );
 }

@@ -5,8 +5,11 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-# apt_install and the build's Debian packages (libclang-dev, binutils, gcc).
+# apt_install and the build's Debian packages (libclang-dev, binutils, gcc),
+# then the other platforms' (win64: Debian's Rust with its sources, mingw,
+# wine).
 source scripts/ensure-build-deps.sh
+source scripts/ensure-cross-deps.sh
 
 echo "== [${SECONDS} s] cargo fmt --check"
 cargo fmt --all -- --check
@@ -24,7 +27,7 @@ for p in eigenmpc-robot-fmu eigenmpc-fmu; do
 done
 echo "== [${SECONDS} s] cargo test"
 cargo test --workspace
-echo "== [${SECONDS} s] fmu-build (release cdylibs, target/fmu/*.fmu, include/eigenmpc.h)"
+echo "== [${SECONDS} s] fmu-build (the FMU binary for linux64 and win64, target/fmu/*.fmu, the C library, include/eigenmpc.h)"
 cargo run -p fmu-build
 
 echo "== [${SECONDS} s] demo (the main job, on the FMUs just built): controller FMU drives plant FMU"
@@ -51,23 +54,10 @@ if bash demo/run.sh --no-build --links 4 --out-dir target/demo-ci-4 2>/dev/null;
     exit 1
 fi
 
-echo "== [${SECONDS} s] C host tests (gcc, include/eigenmpc.h, linked FMU libraries)"
-target_dir=${CARGO_TARGET_DIR:-target}
-# The shipped DoublePendulum.fmu unpacked: its binary linked, its resources
-# telling the binary what it is.
-plant_dir="$target_dir/c-host/DoublePendulum"
-rm -rf "$plant_dir" && mkdir -p "$plant_dir"
-python3 -m zipfile -e "$target_dir/fmu/DoublePendulum.fmu" "$plant_dir"
-plant_dir=$(cd "$plant_dir" && pwd)
-guid=$(grep -o 'guid="[^"]*"' "$plant_dir/modelDescription.xml" | cut -d'"' -f2)
-gcc -std=c11 -Wall -Wextra -Werror -Iinclude tests/c/plant_loop.c \
-    -L"$plant_dir/binaries/linux64" -l:DoublePendulum.so -Wl,-rpath,"$plant_dir/binaries/linux64" \
-    -lm -o "$target_dir/plant_loop"
-"$target_dir/plant_loop" "$guid" "file://$plant_dir/resources"
-gcc -std=c11 -Wall -Wextra -Werror -Iinclude tests/c/controller_loop.c \
-    -L"$target_dir/release" -leigenmpc_fmu -Wl,-rpath,"$(cd "$target_dir/release" && pwd)" \
-    -lm -o "$target_dir/controller_loop"
-"$target_dir/controller_loop"
+echo "== [${SECONDS} s] release CLI (the C hosts export a robot; the Python tests compare with \`eigenmpc simulate\`)"
+cargo build --release --bin eigenmpc
+echo "== [${SECONDS} s] C host tests (include/eigenmpc.h; linux64 with gcc, win64 with mingw under wine)"
+bash tests/c/hosts.sh
 
 echo "== [${SECONDS} s] Python test environment (.venv)"
 if [ ! -x .venv/bin/python ]; then
@@ -112,8 +102,6 @@ if [ "$(cat "$sweep_stamp" 2>/dev/null)" != "$want" ]; then
     .venv/bin/pip install -q --disable-pip-version-check -e python
     echo "$want" >"$sweep_stamp"
 fi
-echo "== [${SECONDS} s] release CLI (the Python tests compare with \`eigenmpc simulate\`)"
-cargo build --release --bin eigenmpc
 echo "== [${SECONDS} s] pytest"
 .venv/bin/python -m pytest tests/python -rs
 echo "== [${SECONDS} s] pytest python/ (the Dask sweep runner against the native sweep)"

@@ -139,10 +139,16 @@ impl Slave {
     }
 }
 
+/// Builds the FMUs with fmu-build: for the host's platform only (the demo
+/// runs there) unless `FMU_PLATFORMS` says otherwise; `tests/run.sh`
+/// builds every platform.
 fn build_fmus() -> Result<()> {
+    use fmu_build::platform::PLATFORMS_ENV;
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let platforms = std::env::var(PLATFORMS_ENV).unwrap_or_else(|_| "linux64".into());
     let status = Command::new(cargo)
         .args(["run", "--quiet", "--release", "-p", "fmu-build"])
+        .env(PLATFORMS_ENV, platforms)
         .status()
         .context("running fmu-build")?;
     if !status.success() {

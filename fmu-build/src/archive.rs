@@ -1,30 +1,43 @@
-//! FMU archives: `modelDescription.xml`, the binary under
+//! FMU archives: `modelDescription.xml`, one binary per platform under
 //! `binaries/<platform>/`, `documentation/index.html` and `resources/`.
 
+use crate::platform::{LINUX64, Platform};
 use anyhow::Result;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use zip::write::SimpleFileOptions;
 
-/// Where the FMU binaries go inside the archive (FMI 2.0 platform name).
-pub const PLATFORM: &str = "linux64";
+/// The library name of the one FMU binary (`eigenmpc-robot-fmu`'s
+/// `[lib] name`); its file name is the platform's
+/// ([`Platform::library`]).
+pub const ROBOT_LIB_NAME: &str = "eigenmpc_robot";
 
-/// File name of the exported robots' binary (`eigenmpc-robot-fmu`).
+/// File name of the FMU binary on the host (linux64).
 pub const ROBOT_LIBRARY: &str = "libeigenmpc_robot.so";
 
-/// Where `fmu-build` puts the stripped exported robots' binary under the
-/// FMU folder `fmu_dir` (`target/fmu`): `robot/<platform>/`.
+/// Where `fmu-build` puts the stripped host (linux64) FMU binary under the
+/// FMU folder `fmu_dir` (`target/fmu`): `robot/linux64/`; the other
+/// platforms' beside it ([`Platform::robot_binary_path`]).
 pub fn robot_binary_path(fmu_dir: &Path) -> PathBuf {
-    fmu_dir.join("robot").join(PLATFORM).join(ROBOT_LIBRARY)
+    LINUX64.robot_binary_path(fmu_dir)
+}
+
+/// One platform's binary of an FMU.
+pub struct Binary<'a> {
+    /// Its platform.
+    pub platform: &'static Platform,
+    /// Its bytes.
+    pub bytes: &'a [u8],
 }
 
 /// Writes the FMU archive `path` of `model_identifier`: its description,
-/// its binary, its documentation page and `resources` (file name, bytes).
+/// its binaries (one per platform), its documentation page and `resources`
+/// (file name, bytes).
 pub fn write_fmu(
     path: &Path,
     model_identifier: &str,
     xml: &str,
-    binary: &[u8],
+    binaries: &[Binary<'_>],
     html: &str,
     resources: &[(&str, &[u8])],
 ) -> Result<()> {
@@ -34,8 +47,10 @@ pub fn write_fmu(
     let exe = opts.unix_permissions(0o755);
     zip.start_file("modelDescription.xml", opts)?;
     zip.write_all(xml.as_bytes())?;
-    zip.start_file(format!("binaries/{PLATFORM}/{model_identifier}.so"), exe)?;
-    zip.write_all(binary)?;
+    for binary in binaries {
+        zip.start_file(binary.platform.archive_path(model_identifier), exe)?;
+        zip.write_all(binary.bytes)?;
+    }
     zip.start_file("documentation/index.html", opts)?;
     zip.write_all(html.as_bytes())?;
     for (name, bytes) in resources {

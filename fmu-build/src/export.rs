@@ -8,7 +8,8 @@
 //! [`export`] returns.
 
 pub use crate::archive::robot_binary_path;
-use crate::archive::{self, PLATFORM, ROBOT_LIBRARY};
+use crate::archive::{self, ROBOT_LIB_NAME, ROBOT_LIBRARY};
+use crate::platform::{PLATFORMS, Platform};
 use crate::ssp::{self, SspSpec};
 use anyhow::{Context, bail};
 use eigenmpc::mechanics::{MechanicalSystem, PlanarChain};
@@ -48,6 +49,8 @@ pub struct Exported {
     pub ssp: PathBuf,
     /// What each FMU is: the controller's and the plant's specs.
     pub specs: [ExportSpec; 2],
+    /// The platforms the FMUs carry a binary for (FMI 2.0 names).
+    pub platforms: Vec<&'static str>,
 }
 
 /// The default energy of an export: 10 % of the potential energy with every
@@ -68,8 +71,14 @@ pub fn export<const N: usize, const S: usize>(
     for named in [&options.names.controller, &options.names.plant] {
         check_name(&named.model_name).context("FMU name")?;
     }
-    let binary = std::fs::read(options.binary)
-        .with_context(|| format!("reading {}", options.binary.display()))?;
+    let binaries = platform_binaries(options.binary)
+        .into_iter()
+        .map(|(platform, path)| {
+            std::fs::read(&path)
+                .with_context(|| format!("reading {}", path.display()))
+                .map(|bytes| (platform, bytes))
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
     let family = options.family;
     let energy = options.energy;
     let eigenvector = linear_modes(system)?
@@ -101,7 +110,7 @@ pub fn export<const N: usize, const S: usize>(
             .map(|f| (FAMILY_FILE, f.as_bytes()))
             .into_iter()
             .collect();
-        let path = write_fmu(out, spec, &binary, &resources)?;
+        let path = write_fmu(out, spec, &binaries, &resources)?;
         validate(&path, spec, family.is_some())
             .with_context(|| format!("validating {}", path.display()))?;
         paths.push(path);
@@ -122,6 +131,7 @@ pub fn export<const N: usize, const S: usize>(
         plant: (plant.model_name.clone(), plant_path),
         ssp,
         specs: [controller, plant],
+        platforms: binaries.iter().map(|(p, _)| p.fmi2).collect(),
     })
 }
 
@@ -180,12 +190,31 @@ pub fn find_binary(given: Option<&Path>) -> anyhow::Result<PathBuf> {
         })
 }
 
-/// Writes `<out>/<model_name>.fmu` of `spec`, with `resources` besides the
-/// spec.
+/// The FMU binary of every platform `fmu-build` built: `host` (the host's,
+/// which an export loads to validate) first, then each other platform's
+/// found beside it (`robot/<platform>/` next to `robot/linux64/`).
+pub fn platform_binaries(host: &Path) -> Vec<(&'static Platform, PathBuf)> {
+    let robot_dir = host.parent().and_then(Path::parent);
+    let mut found = vec![(PLATFORMS[0], host.to_path_buf())];
+    for platform in &PLATFORMS[1..] {
+        if let Some(dir) = robot_dir {
+            let path = dir
+                .join(platform.fmi2)
+                .join(platform.library(ROBOT_LIB_NAME));
+            if path.is_file() {
+                found.push((*platform, path));
+            }
+        }
+    }
+    found
+}
+
+/// Writes `<out>/<model_name>.fmu` of `spec` with its `binaries` (one per
+/// platform), with `resources` besides the spec.
 fn write_fmu(
     out: &Path,
     spec: &ExportSpec,
-    binary: &[u8],
+    binaries: &[(&'static Platform, Vec<u8>)],
     resources: &[(&str, &[u8])],
 ) -> anyhow::Result<PathBuf> {
     let description = spec.description().map_err(anyhow::Error::msg)?;
@@ -206,7 +235,11 @@ fn write_fmu(
     let path = out.join(format!("{}.fmu", spec.model_name));
     let mut files = vec![(SPEC_FILE, json.as_bytes())];
     files.extend_from_slice(resources);
-    archive::write_fmu(&path, &spec.model_name, &xml, binary, &html, &files)?;
+    let binaries: Vec<archive::Binary<'_>> = binaries
+        .iter()
+        .map(|(platform, bytes)| archive::Binary { platform, bytes })
+        .collect();
+    archive::write_fmu(&path, &spec.model_name, &xml, &binaries, &html, &files)?;
     Ok(path)
 }
 
@@ -225,10 +258,7 @@ fn validate(fmu: &Path, spec: &ExportSpec, family: bool) -> anyhow::Result<()> {
     let result = (|| -> anyhow::Result<()> {
         let mut zip = zip::ZipArchive::new(std::fs::File::open(fmu)?)?;
         zip.extract(&dir)?;
-        let library = dir
-            .join("binaries")
-            .join(PLATFORM)
-            .join(format!("{}.so", spec.model_name));
+        let library = dir.join(PLATFORMS[0].archive_path(&spec.model_name));
         let xml = std::fs::read_to_string(dir.join("modelDescription.xml"))?;
         let guid = xml
             .split("guid=\"")

@@ -21,6 +21,7 @@
 
 use fmu_build::archive;
 use fmu_build::export::{self, ExportOptions};
+use fmu_build::platform::{self, PLATFORMS_ENV, Platform};
 use fmu_build::shipped::{SHIPPED, ShippedPair};
 
 use anyhow::{Context, Result, bail};
@@ -35,15 +36,16 @@ struct Library {
     package: &'static str,
     /// Package directory relative to the workspace root (cbindgen's input).
     dir: &'static str,
-    /// File name of the cdylib cargo writes.
-    file: &'static str,
+    /// The crate's `[lib] name` (the cdylib's file name follows the
+    /// platform's).
+    lib_name: &'static str,
 }
 
 /// The one binary of every FMU, shipped or exported.
 const ROBOT: Library = Library {
     package: "eigenmpc-robot-fmu",
     dir: "robot-fmu",
-    file: archive::ROBOT_LIBRARY,
+    lib_name: archive::ROBOT_LIB_NAME,
 };
 
 /// The plain C library: the C API (`eigenmpc_create`, ...) and the
@@ -51,7 +53,7 @@ const ROBOT: Library = Library {
 const C_LIBRARY: Library = Library {
     package: "eigenmpc-fmu",
     dir: "controller-fmu",
-    file: "libeigenmpc_fmu.so",
+    lib_name: "eigenmpc_fmu",
 };
 
 /// Items of the C API that keep their name in the header.
@@ -106,51 +108,159 @@ fn release_build(ws: &Workspace, library: &Library) -> Result<()> {
     Ok(())
 }
 
+/// Debian's Rust that cross-builds (`rustc-web`, `cargo-web`, with the
+/// standard library's sources from `rust-web-src`): rustup cannot add
+/// targets here.
+const CROSS_CARGO: &str = "/usr/bin/cargo";
+const CROSS_RUSTC: &str = "/usr/bin/rustc";
+const CROSS_STD_SOURCES: &str = "/usr/lib/rustlib/src/rust/library";
+
+/// Cross release build of `library` for `platform` into
+/// `target/cross/<triple>/release/`; returns the built library's path.
+/// The standard library is built from source (`-Zbuild-std`, hence
+/// `RUSTC_BOOTSTRAP`), without debug information.
+fn cross_build(ws: &Workspace, library: &Library, platform: &Platform) -> Result<PathBuf> {
+    let linker_found = Command::new(platform.c_compiler)
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !Path::new(CROSS_CARGO).is_file()
+        || !Path::new(CROSS_RUSTC).is_file()
+        || !Path::new(CROSS_STD_SOURCES).is_dir()
+        || !linker_found
+    {
+        bail!(
+            "{}: cross-building needs Debian's rustc-web, cargo-web, rust-web-src and {}: run              `bash scripts/ensure-cross-deps.sh` (as root), or build the host's only with              {PLATFORMS_ENV}=linux64",
+            platform.fmi2,
+            platform.c_compiler
+        );
+    }
+    println!(
+        "== cargo build --release -p {} --target {} (cross)",
+        library.package, platform.target
+    );
+    let cross_target = ws.target.join("cross");
+    let linker_var = format!(
+        "CARGO_TARGET_{}_LINKER",
+        platform.target.to_uppercase().replace('-', "_")
+    );
+    let status = Command::new(CROSS_CARGO)
+        .args([
+            "build",
+            "--release",
+            "-p",
+            library.package,
+            "-Zbuild-std=std,panic_abort",
+            "--target",
+            platform.target,
+            "--target-dir",
+        ])
+        .arg(&cross_target)
+        .env("RUSTC", CROSS_RUSTC)
+        .env("RUSTC_BOOTSTRAP", "1")
+        .env(linker_var, platform.c_compiler)
+        .env("CARGO_PROFILE_RELEASE_DEBUG", "0")
+        .env_remove("RUSTUP_TOOLCHAIN")
+        .env_remove("CARGO_TARGET_DIR")
+        .current_dir(&ws.root)
+        .status()
+        .with_context(|| format!("running {CROSS_CARGO}"))?;
+    if !status.success() {
+        bail!(
+            "cross build of {} for {} failed",
+            library.package,
+            platform.fmi2
+        );
+    }
+    Ok(cross_target
+        .join(platform.target)
+        .join("release")
+        .join(platform.library(library.lib_name)))
+}
+
 /// The FMU's binary without debug information (the release profile keeps
 /// it for profiling: 20-26 MB against 2-3 MB), which goes to
 /// `target/fmu/<modelIdentifier>.so.debug`, linked by `.gnu_debuglink` for
 /// debuggers. Needs binutils' `objcopy` (Debian `binutils`, installed with
 /// gcc by `tests/run.sh`).
-fn stripped_binary(ws: &Workspace, library: &str, name: &str) -> Result<Vec<u8>> {
-    let library = ws.target.join("release").join(library);
+fn stripped_binary(ws: &Workspace, library: &Path, platform: &Platform) -> Result<Vec<u8>> {
     let dir = ws.target.join("fmu");
-    let debug = dir.join(format!("{name}.so.debug"));
-    let stripped = dir.join(format!("{name}.so"));
+    let name = format!("{}{}", archive::ROBOT_LIB_NAME, platform.library_suffix);
+    let debug = dir.join(format!("{name}.debug"));
+    let stripped = dir.join(&name);
     let objcopy = |args: &[&std::ffi::OsStr]| -> Result<()> {
-        let status = Command::new("objcopy")
+        let status = Command::new(platform.objcopy)
             .args(args)
             .status()
-            .context("running objcopy (Debian package binutils) to strip the FMU binary")?;
+            .with_context(|| {
+                format!(
+                    "running {} (binutils) to strip the FMU binary",
+                    platform.objcopy
+                )
+            })?;
         if !status.success() {
-            bail!("objcopy {args:?} failed");
+            bail!("{} {args:?} failed", platform.objcopy);
         }
         Ok(())
     };
-    objcopy(&[
-        "--only-keep-debug".as_ref(),
-        library.as_os_str(),
-        debug.as_os_str(),
-    ])?;
-    objcopy(&[
-        "--strip-unneeded".as_ref(),
-        format!("--add-gnu-debuglink={}", debug.display()).as_ref(),
-        library.as_os_str(),
-        stripped.as_os_str(),
-    ])?;
+    if platform.native {
+        objcopy(&[
+            "--only-keep-debug".as_ref(),
+            library.as_os_str(),
+            debug.as_os_str(),
+        ])?;
+        objcopy(&[
+            "--strip-unneeded".as_ref(),
+            format!("--add-gnu-debuglink={}", debug.display()).as_ref(),
+            library.as_os_str(),
+            stripped.as_os_str(),
+        ])?;
+    } else {
+        // Cross builds carry no debug information; the symbol table goes.
+        objcopy(&[
+            "--strip-unneeded".as_ref(),
+            library.as_os_str(),
+            stripped.as_os_str(),
+        ])?;
+    }
     let binary =
         std::fs::read(&stripped).with_context(|| format!("reading {}", stripped.display()))?;
     std::fs::remove_file(&stripped)?;
     Ok(binary)
 }
 
-/// The exported robots' binary (`eigenmpc export` copies it into every
-/// FMU it writes), stripped, at [`archive::robot_binary_path`].
-fn robot_binary(ws: &Workspace) -> Result<PathBuf> {
-    release_build(ws, &ROBOT)?;
-    let binary = stripped_binary(ws, ROBOT.file, "eigenmpc_robot")?;
-    let path = archive::robot_binary_path(&ws.target.join("fmu"));
+/// The one FMU binary for `platform` (`eigenmpc export` and the shipped
+/// FMUs carry it), stripped, at [`Platform::robot_binary_path`].
+fn robot_binary(ws: &Workspace, platform: &Platform) -> Result<PathBuf> {
+    let built = if platform.native {
+        release_build(ws, &ROBOT)?;
+        ws.target
+            .join("release")
+            .join(platform.library(ROBOT.lib_name))
+    } else {
+        cross_build(ws, &ROBOT, platform)?
+    };
+    let binary = stripped_binary(ws, &built, platform)?;
+    let path = platform.robot_binary_path(&ws.target.join("fmu"));
     std::fs::create_dir_all(path.parent().context("robot binary folder")?)?;
     std::fs::write(&path, binary)?;
+    Ok(path)
+}
+
+/// The C library for `platform`, copied to `target/fmu/c/<platform>/`.
+fn c_library(ws: &Workspace, platform: &Platform) -> Result<PathBuf> {
+    let built = if platform.native {
+        release_build(ws, &C_LIBRARY)?;
+        ws.target
+            .join("release")
+            .join(platform.library(C_LIBRARY.lib_name))
+    } else {
+        cross_build(ws, &C_LIBRARY, platform)?
+    };
+    let dir = ws.target.join("fmu").join("c").join(platform.fmi2);
+    std::fs::create_dir_all(&dir)?;
+    let path = dir.join(platform.library(C_LIBRARY.lib_name));
+    std::fs::copy(&built, &path).with_context(|| format!("copying {}", built.display()))?;
     Ok(path)
 }
 
@@ -287,23 +397,27 @@ fn update_readme(ws: &Workspace) -> Result<bool> {
 fn main() -> Result<()> {
     let ws = workspace()?;
     std::fs::create_dir_all(ws.target.join("fmu"))?;
-    let robot = robot_binary(&ws)?;
-    println!(
-        "wrote {} (the binary of every FMU, shipped or exported)",
-        robot.display()
-    );
+    let platforms = platform::selected().map_err(anyhow::Error::msg)?;
+    for p in &platforms {
+        let robot = robot_binary(&ws, p)?;
+        println!(
+            "wrote {} (the binary of every FMU, shipped or exported, on {})",
+            robot.display(),
+            p.fmi2
+        );
+    }
+    let host = archive::robot_binary_path(&ws.target.join("fmu"));
     for pair in SHIPPED {
-        for (model_identifier, xml) in export_pair(&ws, pair, &robot)? {
+        for (model_identifier, xml) in export_pair(&ws, pair, &host)? {
             if update_checked_in(&ws, &model_identifier, &xml)? {
                 println!("updated modelDescription/{model_identifier}.xml: commit it");
             }
         }
     }
-    release_build(&ws, &C_LIBRARY)?;
-    println!(
-        "built {} (the C API)",
-        ws.target.join("release").join(C_LIBRARY.file).display()
-    );
+    for p in &platforms {
+        let path = c_library(&ws, p)?;
+        println!("wrote {} (the C library, {})", path.display(), p.fmi2);
+    }
     let h = header(&ws)?;
     println!("wrote {}", h.display());
     if update_readme(&ws)? {

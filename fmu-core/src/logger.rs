@@ -35,7 +35,7 @@ pub const LOG_CATEGORIES: [(&str, &str); 4] = [
     ("logStatusError", "Errors: why a call returned fmi2Error"),
     (
         "logStatusWarning",
-        "Warnings: why a call returned fmi2Warning or fmi2Discard",
+        "Warnings: why a call returned fmi2Warning or fmi2Discard; notices (status OK) of documented behaviour a call carried out",
     ),
     (
         "logEvents",
@@ -178,11 +178,12 @@ impl Logger {
         self.log(Category::StatusWarning, Status::Warning, message);
     }
 
-    /// Logs a warning under `logStatusWarning` without changing the call's
+    /// Logs a notice under `logStatusWarning` at status OK, the call's own
     /// status: for behaviour that is documented and was carried out (some
-    /// masters stop at the first `fmi2Warning`).
+    /// masters stop at the first `fmi2Warning`, and a message a host shows
+    /// as a warning must come with one).
     pub fn notice(&self, message: &str) {
-        self.log(Category::StatusWarning, Status::Warning, message);
+        self.log(Category::StatusWarning, Status::Ok, message);
     }
 
     /// Logs an event (`logEvents`).

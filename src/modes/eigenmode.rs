@@ -8,7 +8,7 @@
 //! equations, and continuation in energy from the linear mode at small energy.
 
 use super::{ModeError, linear_modes};
-use crate::integrate::{Dopri5, Tolerances, Variational, variational_rhs};
+use crate::integrate::{Dopri5, IntegrationError, Tolerances, Variational, variational_rhs};
 use crate::mechanics::{
     Conservative, MechanicalSystem, Vector, pack_state, state_derivative, state_jacobian,
     unpack_state,
@@ -57,6 +57,52 @@ pub struct ContinuationOptions {
     pub start_energy: f64,
     /// Closing error and turning speed above this fail verification.
     pub verification_tolerance: f64,
+    /// Work limit of one continuation: right-hand-side evaluations of the
+    /// integrator over every shot and verification. A model whose time
+    /// scales are far apart (a very light, heavy, long or stiff link) needs
+    /// tiny steps; the limit stops it with [`ModeError::WorkLimit`] instead
+    /// of an unbounded pause. Absent in files written before it existed.
+    #[serde(default = "default_max_evaluations")]
+    pub max_evaluations: usize,
+}
+
+/// [`ContinuationOptions::max_evaluations`] by default.
+pub const DEFAULT_MAX_EVALUATIONS: usize = 3_000_000;
+
+fn default_max_evaluations() -> usize {
+    DEFAULT_MAX_EVALUATIONS
+}
+
+/// The integration work a continuation may still spend, shared by its shots
+/// and verifications.
+struct Work {
+    left: usize,
+}
+
+impl Work {
+    fn new(limit: usize) -> Self {
+        Self { left: limit }
+    }
+
+    /// An integrator whose step budget is the work left (6 evaluations per
+    /// attempted step): running out of it is [`IntegrationError::TooManySteps`].
+    fn ode<Y: crate::integrate::OdeState>(&self, y0: Y, tol: Tolerances) -> Dopri5<Y> {
+        let mut ode = Dopri5::new(0.0, y0, tol);
+        ode.max_steps = self.left / 6;
+        ode
+    }
+
+    /// Books the evaluations `ode` made.
+    fn spend<Y: crate::integrate::OdeState>(&mut self, ode: &Dopri5<Y>) {
+        self.left = self.left.saturating_sub(ode.evaluations());
+    }
+}
+
+/// Why a shot failed: an ordinary failure (the step is halved) or the work
+/// limit (the continuation stops).
+enum ShotError {
+    Failed(String),
+    OutOfWork,
 }
 
 impl Default for ContinuationOptions {
@@ -71,6 +117,7 @@ impl Default for ContinuationOptions {
             max_energy_step: 2.0,
             start_energy: 0.05,
             verification_tolerance: 1e-8,
+            max_evaluations: DEFAULT_MAX_EVALUATIONS,
         }
     }
 }
@@ -89,7 +136,8 @@ fn shoot<S, const N: usize, const NX: usize>(
     energy: f64,
     guess: Shot<N>,
     opts: &ContinuationOptions,
-) -> Result<Shot<N>, String>
+    work: &mut Work,
+) -> Result<Shot<N>, ShotError>
 where
     S: MechanicalSystem<N> + ?Sized,
 {
@@ -97,16 +145,24 @@ where
     let (mut q0, mut half) = (guess.q0, guess.half_period);
     for iteration in 0..=opts.max_newton_iterations {
         if !(half > 0.0 && half.is_finite()) {
-            return Err(format!("half period left the admissible range ({half})"));
+            return Err(ShotError::Failed(format!(
+                "half period left the admissible range ({half})"
+            )));
         }
         let start = Variational {
             z: pack_state::<N, NX>(&q0, &zero),
             phi: SMatrix::<f64, NX, NX>::identity(),
         };
-        let mut ode = Dopri5::new(0.0, start, opts.tolerances);
-        let end = *ode
+        let mut ode = work.ode(start, opts.tolerances);
+        let end = ode
             .advance_to(|_, v| variational_rhs::<S, N, NX>(system, &zero, v), half)
-            .map_err(|e| e.to_string())?;
+            .copied();
+        work.spend(&ode);
+        let end = match end {
+            Ok(end) => end,
+            Err(IntegrationError::TooManySteps { .. }) => return Err(ShotError::OutOfWork),
+            Err(e) => return Err(ShotError::Failed(e.to_string())),
+        };
         let (_, qd_end) = unpack_state::<N, NX>(&end.z);
         let residual_energy = system.potential(&q0) - energy;
         let residual = DVector::from_fn(N + 1, |i, _| {
@@ -137,14 +193,14 @@ where
         let svd = jac.clone().svd(true, true);
         let (smax, smin) = (svd.singular_values.max(), svd.singular_values.min());
         if smin.is_nan() || smin <= 1e-12 * smax {
-            return Err(format!(
+            return Err(ShotError::Failed(format!(
                 "singular shooting Jacobian (condition {:.1e}): fold or bifurcation of the family",
                 smax / smin
-            ));
+            )));
         }
         let mut step = svd
             .solve(&(-residual), 0.0)
-            .map_err(|e| format!("linear solve failed: {e}"))?;
+            .map_err(|e| ShotError::Failed(format!("linear solve failed: {e}")))?;
         // Damp large steps: the continuation predictor is good, a big step
         // means Newton is heading for another branch.
         let size = step.rows(0, N).amax().max(step[N].abs() / half.max(1e-3));
@@ -156,10 +212,16 @@ where
         }
         half += step[N];
     }
-    Err(format!(
+    Err(ShotError::Failed(format!(
         "Newton did not converge in {} iterations",
         opts.max_newton_iterations
-    ))
+    )))
+}
+
+/// Why a verification failed.
+enum VerifyError {
+    Mode(ModeError),
+    OutOfWork,
 }
 
 /// Integrates the orbit for one full period: path samples, closing error, turning speed.
@@ -168,34 +230,46 @@ fn verify<S, const N: usize, const NX: usize>(
     energy: f64,
     shot: &Shot<N>,
     opts: &ContinuationOptions,
-) -> Result<Eigenmode<N>, ModeError>
+    work: &mut Work,
+) -> Result<Eigenmode<N>, VerifyError>
 where
     S: MechanicalSystem<N> + ?Sized,
 {
     let zero = Vector::<N>::zeros();
     let z0: SVector<f64, NX> = pack_state::<N, NX>(&shot.q0, &zero);
-    let mut ode = Dopri5::new(0.0, z0, opts.tolerances);
+    let mut ode = work.ode(z0, opts.tolerances);
     let samples = opts.samples.max(2);
     let mut path = Vec::with_capacity(samples);
     let f = |_: f64, z: &SVector<f64, NX>| state_derivative::<S, N, NX>(system, z, &zero);
     path.push(shot.q0);
+    let mut integrate = |ode: &mut Dopri5<SVector<f64, NX>>, t: f64| {
+        let before = ode.evaluations();
+        ode.max_steps = work.left / 6;
+        let outcome = ode.advance_to(f, t).copied();
+        let spent = ode.evaluations() - before;
+        work.left = work.left.saturating_sub(spent);
+        outcome.map_err(|e| match e {
+            IntegrationError::TooManySteps { .. } => VerifyError::OutOfWork,
+            e => VerifyError::Mode(e.into()),
+        })
+    };
     for i in 1..samples {
         let t = shot.half_period * i as f64 / (samples - 1) as f64;
-        let z = ode.advance_to(f, t)?;
-        path.push(unpack_state::<N, NX>(z).0);
+        let z = integrate(&mut ode, t)?;
+        path.push(unpack_state::<N, NX>(&z).0);
     }
     let (other, qd_half) = unpack_state::<N, NX>(ode.state());
-    let z_end = *ode.advance_to(f, 2.0 * shot.half_period)?;
+    let z_end = integrate(&mut ode, 2.0 * shot.half_period)?;
     let closing_error = (z_end - z0).amax();
     let turning_speed = qd_half.amax();
     let tol = opts.verification_tolerance;
     if !(closing_error <= tol && turning_speed <= tol) {
-        return Err(ModeError::VerificationFailed {
+        return Err(VerifyError::Mode(ModeError::VerificationFailed {
             energy,
             reason: format!(
                 "closing error {closing_error:.2e}, turning speed {turning_speed:.2e} (limit {tol:.0e})"
             ),
-        });
+        }));
     }
     Ok(Eigenmode {
         energy,
@@ -309,13 +383,23 @@ where
         requested,
         reason,
     };
-    let first = shoot::<_, N, NX>(system, e_start, guess, opts).map_err(|r| {
-        fail(
-            0.0,
-            lowest,
-            format!("no orbit at the continuation's start energy {e_start} J: {r}"),
-        )
-    })?;
+    let mut work = Work::new(opts.max_evaluations);
+    let out_of_work = |reached: f64| ModeError::WorkLimit {
+        family: family.clone(),
+        reached,
+        limit: opts.max_evaluations,
+    };
+    let first = match shoot::<_, N, NX>(system, e_start, guess, opts, &mut work) {
+        Ok(shot) => shot,
+        Err(ShotError::OutOfWork) => return Err(out_of_work(0.0)),
+        Err(ShotError::Failed(r)) => {
+            return Err(fail(
+                0.0,
+                lowest,
+                format!("no orbit at the continuation's start energy {e_start} J: {r}"),
+            ));
+        }
+    };
     // History for the secant predictor, parametrised by sqrt(E) (amplitude
     // grows like sqrt(E) near the equilibrium).
     let mut prev: Option<(f64, Shot<N>)> = None;
@@ -336,7 +420,8 @@ where
                 }
                 None => cur.1,
             };
-            match shoot::<_, N, NX>(system, e_next, predicted, opts) {
+            match shoot::<_, N, NX>(system, e_next, predicted, opts, &mut work) {
+                Err(ShotError::OutOfWork) => return Err(out_of_work(cur.0)),
                 Ok(shot) if c.dot(&(shot.q0 - q_eq)) > 0.0 => {
                     prev = Some(cur);
                     cur = (e_next, shot);
@@ -348,7 +433,8 @@ where
                     step *= 0.5;
                     if step < opts.min_energy_step {
                         let reason = match outcome {
-                            Err(r) => r,
+                            Err(ShotError::Failed(r)) => r,
+                            Err(ShotError::OutOfWork) => unreachable!("handled above"),
                             Ok(_) => {
                                 "the turning point crossed to the other side of the mode".into()
                             }
@@ -360,7 +446,12 @@ where
         }
         // The loop ends exactly on target (steps are clipped to it).
         let shot = cur.1;
-        if !on_mode(verify::<_, N, NX>(system, target, &shot, opts)?) {
+        let mode = match verify::<_, N, NX>(system, target, &shot, opts, &mut work) {
+            Ok(mode) => mode,
+            Err(VerifyError::OutOfWork) => return Err(out_of_work(cur.0)),
+            Err(VerifyError::Mode(e)) => return Err(e),
+        };
+        if !on_mode(mode) {
             break;
         }
     }

@@ -203,6 +203,7 @@ impl<const N: usize> ChartFamily<N> {
         family.ended = match outcome {
             Err(ModeError::ContinuationFailed { .. })
             | Err(ModeError::VerificationFailed { .. })
+            | Err(ModeError::WorkLimit { .. })
                 if family.energies.len() >= 2 =>
             {
                 Some(outcome.unwrap_err().to_string())

@@ -65,6 +65,21 @@ pub enum ModeError {
         /// Fold, singular Jacobian, non-convergence, ...
         reason: String,
     },
+    /// The continuation used up its work limit
+    /// ([`ContinuationOptions::max_evaluations`]).
+    #[error(
+        "the {family} stopped at its work limit ({limit} integrator evaluations) at E = {reached:.4} J: \
+         the model's time scales are too far apart (a very light, heavy, long or stiff link) to \
+         compute its orbits in bounded time"
+    )]
+    WorkLimit {
+        /// Family name.
+        family: String,
+        /// Highest energy for which an orbit was found (J).
+        reached: f64,
+        /// The limit.
+        limit: usize,
+    },
     /// An orbit was found but does not verify (closing error or turning speed too large).
     #[error("orbit at E = {energy} J fails verification: {reason}")]
     VerificationFailed {

@@ -5,6 +5,7 @@ functions and nothing else (the plain C API is libeigenmpc_fmu.so, tested by
 the C host tests), and resources/ saying which model it is."""
 
 import json
+import os
 
 import subprocess
 import zipfile
@@ -45,3 +46,37 @@ def test_resources_say_which_model_the_binary_is(identifier):
     assert spec["joints"] == (3 if identifier.endswith("3") or identifier.startswith("Triple") else 2)
     # The controllers carry their mode family, computed at packaging.
     assert ("resources/eigenmpc-family.json" in names) == (spec["kind"] == "controller")
+
+
+# The Windows system libraries a win64 FMU binary may import (Rust's
+# standard library and the mingw C runtime): nothing a user has to install.
+WINDOWS_SYSTEM_DLLS = {
+    "kernel32.dll", "msvcrt.dll", "ntdll.dll", "userenv.dll", "ws2_32.dll",
+    "api-ms-win-core-synch-l1-2-0.dll", "bcryptprimitives.dll", "advapi32.dll",
+}
+
+
+@pytest.mark.parametrize("identifier", FMUS)
+def test_win64_binaries_export_the_fmi_functions_and_import_only_windows(identifier, tmp_path):
+    if "win64" not in os.environ.get("FMU_PLATFORMS", "win64"):
+        pytest.skip("FMU_PLATFORMS leaves win64 out")
+    with zipfile.ZipFile(fmu_path(identifier)) as z:
+        name = f"binaries/win64/{identifier}.dll"
+        assert name in z.namelist(), "no win64 binary"
+        size = z.getinfo(name).file_size
+        z.extract(name, tmp_path)
+    FIGURES.append(f"{identifier}.fmu win64 binary: {size / 1e6:.1f} MB unzipped")
+    assert size < 12e6, f"{size} bytes: not stripped?"
+    out = subprocess.run(["x86_64-w64-mingw32-objdump", "-p", str(tmp_path / name)],
+                         check=True, capture_output=True, text=True).stdout
+    table = out.split("[Ordinal/Name Pointer] Table", 1)[1]
+    exported = set()
+    for line in table.splitlines()[1:]:
+        parts = line.strip().split()
+        if len(parts) != 3 or not parts[0].startswith("["):
+            break
+        exported.add(parts[2])
+    fmi = {s for s in exported if s.startswith("fmi2")}
+    assert len(fmi) == 34 and exported == fmi, sorted(exported)
+    imported = {line.split(":", 1)[1].strip().lower() for line in out.splitlines() if "DLL Name:" in line}
+    assert imported <= WINDOWS_SYSTEM_DLLS, sorted(imported - WINDOWS_SYSTEM_DLLS)

@@ -108,9 +108,10 @@ fn run_for<const N: usize, const S: usize>(
     let written = export::<N, S>(system, &options, &args.out)?;
     println!(
         "{} ({N} joints): {family} eigenmode at E_ref = {energy:.6} J, chart degree {}, \
-         |tau| <= {tau_max} N m",
+         |tau| <= {tau_max} N m; binaries for {}",
         args.model.display(),
-        args.chart_degree
+        args.chart_degree,
+        written.platforms.join(", ")
     );
     for path in [&written.controller.1, &written.plant.1, &written.ssp] {
         println!("wrote {}", path.display());
