@@ -289,6 +289,7 @@ fn co_simulate<const N: usize, const NX: usize>(
                 tau_max,
                 chart_degree: 9,
                 binary: &export::find_binary(Some(&binary))?,
+                fmi3: false,
             };
             let written = export::export::<N, NX>(&model, &options, &args.out_dir.join("fmu"))?;
             println!(

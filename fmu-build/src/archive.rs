@@ -1,7 +1,7 @@
 //! FMU archives: `modelDescription.xml`, one binary per platform under
 //! `binaries/<platform>/`, `documentation/index.html` and `resources/`.
 
-use crate::platform::{LINUX64, Platform};
+use crate::platform::{FmiVersion, LINUX64, Platform};
 use anyhow::Result;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
@@ -30,11 +30,12 @@ pub struct Binary<'a> {
     pub bytes: &'a [u8],
 }
 
-/// Writes the FMU archive `path` of `model_identifier`: its description,
-/// its binaries (one per platform), its documentation page and `resources`
-/// (file name, bytes).
+/// Writes the FMU archive `path` of FMI `version` of `model_identifier`: its
+/// description, its binaries (one per platform), its documentation page and
+/// `resources` (file name, bytes).
 pub fn write_fmu(
     path: &Path,
+    version: FmiVersion,
     model_identifier: &str,
     xml: &str,
     binaries: &[Binary<'_>],
@@ -48,7 +49,10 @@ pub fn write_fmu(
     zip.start_file("modelDescription.xml", opts)?;
     zip.write_all(xml.as_bytes())?;
     for binary in binaries {
-        zip.start_file(binary.platform.archive_path(model_identifier), exe)?;
+        zip.start_file(
+            binary.platform.archive_path_in(version, model_identifier),
+            exe,
+        )?;
         zip.write_all(binary.bytes)?;
     }
     zip.start_file("documentation/index.html", opts)?;

@@ -9,8 +9,10 @@
 
 pub use crate::archive::robot_binary_path;
 use crate::archive::{self, ROBOT_LIB_NAME, ROBOT_LIBRARY};
+pub use crate::platform::FmiVersion;
 use crate::platform::{PLATFORMS, Platform};
 use crate::ssp::{self, SspSpec};
+use crate::validate;
 use anyhow::{Context, bail};
 use eigenmpc::mechanics::{MechanicalSystem, PlanarChain};
 use eigenmpc::modes::{Family, linear_modes};
@@ -37,6 +39,9 @@ pub struct ExportOptions<'a> {
     pub chart_degree: usize,
     /// The exported robots' FMU binary.
     pub binary: &'a Path,
+    /// Also FMI 3.0 archives (`fmi3/<name>.fmu`) beside the FMI 2.0 ones
+    /// (`<name>.fmu`, always written: the SSP couples them).
+    pub fmi3: bool,
 }
 
 /// The files an export wrote.
@@ -49,6 +54,8 @@ pub struct Exported {
     pub ssp: PathBuf,
     /// What each FMU is: the controller's and the plant's specs.
     pub specs: [ExportSpec; 2],
+    /// Every archive written (controller and plant, per FMI version).
+    pub archives: Vec<PathBuf>,
     /// The platforms the FMUs carry a binary for (FMI 2.0 names).
     pub platforms: Vec<&'static str>,
 }
@@ -103,17 +110,26 @@ pub fn export<const N: usize, const S: usize>(
     let family = family_resource::<N, S>(&controller)
         .map_err(anyhow::Error::msg)
         .context("the controller's mode family")?;
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    let mut paths = vec![];
-    for (spec, family) in [(&controller, family.as_deref()), (&plant, None)] {
-        let resources: Vec<(&str, &[u8])> = family
-            .map(|f| (FAMILY_FILE, f.as_bytes()))
-            .into_iter()
-            .collect();
-        let path = write_fmu(out, spec, &binaries, &resources)?;
-        validate(&path, spec, family.is_some())
-            .with_context(|| format!("validating {}", path.display()))?;
-        paths.push(path);
+    let versions: &[FmiVersion] = if options.fmi3 {
+        &[FmiVersion::Fmi2, FmiVersion::Fmi3]
+    } else {
+        &[FmiVersion::Fmi2]
+    };
+    let mut archives = vec![];
+    for &version in versions {
+        for (spec, family) in [(&controller, family.as_deref()), (&plant, None)] {
+            let resources: Vec<(&str, &[u8])> = family
+                .map(|f| (FAMILY_FILE, f.as_bytes()))
+                .into_iter()
+                .collect();
+            let path = version.archive(out, &spec.model_name);
+            let dir = path.parent().context("archive folder")?;
+            std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+            write_fmu(&path, version, spec, &binaries, &resources)?;
+            validate::archive(&path, version, spec, family.is_some())
+                .with_context(|| format!("validating {}", path.display()))?;
+            archives.push(path);
+        }
     }
     let ssp = ssp::package(
         out,
@@ -124,13 +140,18 @@ pub fn export<const N: usize, const S: usize>(
             joints: N,
         },
     )?;
-    let plant_path = paths.pop().context("plant archive")?;
-    let controller_path = paths.pop().context("controller archive")?;
     Ok(Exported {
-        controller: (controller.model_name.clone(), controller_path),
-        plant: (plant.model_name.clone(), plant_path),
+        controller: (
+            controller.model_name.clone(),
+            FmiVersion::Fmi2.archive(out, &controller.model_name),
+        ),
+        plant: (
+            plant.model_name.clone(),
+            FmiVersion::Fmi2.archive(out, &plant.model_name),
+        ),
         ssp,
         specs: [controller, plant],
+        archives,
         platforms: binaries.iter().map(|(p, _)| p.fmi2).collect(),
     })
 }
@@ -209,16 +230,20 @@ pub fn platform_binaries(host: &Path) -> Vec<(&'static Platform, PathBuf)> {
     found
 }
 
-/// Writes `<out>/<model_name>.fmu` of `spec` with its `binaries` (one per
-/// platform), with `resources` besides the spec.
+/// Writes the archive `path` of FMI `version` of `spec` with its `binaries`
+/// (one per platform), with `resources` besides the spec.
 fn write_fmu(
-    out: &Path,
+    path: &Path,
+    version: FmiVersion,
     spec: &ExportSpec,
     binaries: &[(&'static Platform, Vec<u8>)],
     resources: &[(&str, &[u8])],
-) -> anyhow::Result<PathBuf> {
+) -> anyhow::Result<()> {
     let description = spec.description().map_err(anyhow::Error::msg)?;
-    let xml = fmi2_slave::xml::model_description_xml(&description);
+    let xml = match version {
+        FmiVersion::Fmi2 => fmi2_slave::xml::model_description_xml(&description),
+        FmiVersion::Fmi3 => fmi3_slave::xml::model_description_xml(&description),
+    };
     let kind = match spec.kind {
         Kind::Controller => eigenmpc_fmu_models::controller::docs::documentation_html(spec.joints),
         Kind::Plant => eigenmpc_fmu_models::plant::docs::documentation_html(spec.joints),
@@ -232,130 +257,21 @@ fn write_fmu(
     );
     let html = fmi2_slave::xml::documentation_html(&description, &intro);
     let json = serde_json::to_string_pretty(spec)?;
-    let path = out.join(format!("{}.fmu", spec.model_name));
     let mut files = vec![(SPEC_FILE, json.as_bytes())];
     files.extend_from_slice(resources);
     let binaries: Vec<archive::Binary<'_>> = binaries
         .iter()
         .map(|(platform, bytes)| archive::Binary { platform, bytes })
         .collect();
-    archive::write_fmu(&path, &spec.model_name, &xml, &binaries, &html, &files)?;
-    Ok(path)
-}
-
-/// Loads the archive as a host does (unpacked into a temporary folder, the
-/// binary opened, `fmuResourceLocation` a `file:` URI) and runs one second
-/// of co-simulation from the start values; `family`: the controller must
-/// take the mode family of its resources (its log says so).
-fn validate(fmu: &Path, spec: &ExportSpec, family: bool) -> anyhow::Result<()> {
-    use fmi2_slave::ffi;
-    let dir = std::env::temp_dir().join(format!(
-        "eigenmpc-export-{}-{}",
-        std::process::id(),
-        spec.model_name
-    ));
-    std::fs::create_dir_all(&dir)?;
-    let result = (|| -> anyhow::Result<()> {
-        let mut zip = zip::ZipArchive::new(std::fs::File::open(fmu)?)?;
-        zip.extract(&dir)?;
-        let library = dir.join(PLATFORMS[0].archive_path(&spec.model_name));
-        let xml = std::fs::read_to_string(dir.join("modelDescription.xml"))?;
-        let guid = xml
-            .split("guid=\"")
-            .nth(1)
-            .and_then(|r| r.split('"').next())
-            .context("no guid in modelDescription.xml")?;
-        // SAFETY: the binary is ours (eigenmpc-robot-fmu): loading runs no
-        // foreign initialisers.
-        let lib = unsafe { ffi::Fmi2Binding::new(&library) }
-            .with_context(|| format!("loading {}", library.display()))?;
-        let log = fmi2_slave::testing::LogCapture::new();
-        let callbacks = log.callbacks();
-        let c_name = std::ffi::CString::new(spec.model_name.as_str())?;
-        let c_guid = std::ffi::CString::new(guid)?;
-        let uri = std::ffi::CString::new(file_uri(&dir.join("resources")))?;
-        // The binding's symbols are fn pointers: copy each out.
-        macro_rules! sym {
-            ($name:ident) => {
-                *lib.$name
-                    .as_ref()
-                    .map_err(|e| anyhow::anyhow!("{}: {e}", stringify!($name)))?
-            };
-        }
-        let ok = |status: ffi::fmi2Status, call: &str| -> anyhow::Result<()> {
-            if status != ffi::fmi2Status_fmi2OK {
-                let lines: Vec<String> = log.lines().iter().map(|l| l.message.clone()).collect();
-                bail!("{call} returned {status}: {}", lines.join("; "));
-            }
-            Ok(())
-        };
-        // SAFETY: the FMI 2.0 calling sequence with valid arguments; the
-        // callbacks and strings outlive the instance.
-        unsafe {
-            let instance = sym!(fmi2Instantiate)(
-                c_name.as_ptr(),
-                ffi::fmi2Type_fmi2CoSimulation,
-                c_guid.as_ptr(),
-                uri.as_ptr(),
-                &callbacks,
-                0,
-                1,
-            );
-            if instance.is_null() {
-                let lines: Vec<String> = log.lines().iter().map(|l| l.message.clone()).collect();
-                bail!("fmi2Instantiate failed: {}", lines.join("; "));
-            }
-            let dt = 0.025;
-            let run = (|| -> anyhow::Result<()> {
-                ok(
-                    sym!(fmi2SetupExperiment)(instance, 0, 0.0, 0.0, 0, 0.0),
-                    "fmi2SetupExperiment",
-                )?;
-                ok(
-                    sym!(fmi2EnterInitializationMode)(instance),
-                    "fmi2EnterInitializationMode",
-                )?;
-                ok(
-                    sym!(fmi2ExitInitializationMode)(instance),
-                    "fmi2ExitInitializationMode",
-                )?;
-                let taken = log
-                    .lines()
-                    .iter()
-                    .any(|l| l.message.contains("the one computed at export"));
-                if family && !taken {
-                    let lines: Vec<String> =
-                        log.lines().iter().map(|l| l.message.clone()).collect();
-                    bail!(
-                        "the controller did not take the exported mode family: {}",
-                        lines.join("; ")
-                    );
-                }
-                let step = sym!(fmi2DoStep);
-                for k in 0..40 {
-                    ok(step(instance, k as f64 * dt, dt, 1), "fmi2DoStep")?;
-                }
-                ok(sym!(fmi2Terminate)(instance), "fmi2Terminate")
-            })();
-            sym!(fmi2FreeInstance)(instance);
-            run
-        }
-    })();
-    std::fs::remove_dir_all(&dir).ok();
-    result
-}
-
-/// `file:///...` of a folder, percent-encoding what a URI path cannot hold.
-fn file_uri(path: &Path) -> String {
-    let mut uri = String::from("file://");
-    for b in path.display().to_string().bytes() {
-        if b.is_ascii_alphanumeric() || b"/-_.~".contains(&b) {
-            uri.push(b as char);
-        } else {
-            uri.push_str(&format!("%{b:02X}"));
-        }
-    }
-    uri
+    archive::write_fmu(
+        path,
+        version,
+        &spec.model_name,
+        &xml,
+        &binaries,
+        &html,
+        &files,
+    )
 }
 
 #[cfg(test)]
@@ -370,17 +286,5 @@ mod tests {
         assert!(check_name("2link").is_err());
         assert!(check_name("a-b").is_err());
         assert!(check_name("").is_err());
-    }
-
-    #[test]
-    fn uris_of_folders() {
-        assert_eq!(
-            file_uri(Path::new("/tmp/a b/resources")),
-            "file:///tmp/a%20b/resources"
-        );
-        assert_eq!(
-            fmi2_slave::resources::resource_dir(&file_uri(Path::new("/tmp/a b%/r"))),
-            Some(PathBuf::from("/tmp/a b%/r"))
-        );
     }
 }

@@ -9,3 +9,4 @@ pub mod export;
 pub mod platform;
 pub mod shipped;
 pub mod ssp;
+pub mod validate;

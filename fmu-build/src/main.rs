@@ -264,9 +264,10 @@ fn c_library(ws: &Workspace, platform: &Platform) -> Result<PathBuf> {
     Ok(path)
 }
 
-/// Writes the shipped `pair` into `target/fmu` as `eigenmpc export` would,
-/// from the one binary at `binary`; returns the written archives and the
-/// FMUs' `(modelIdentifier, modelDescription.xml)`.
+/// Writes the shipped `pair` into `target/fmu` (FMI 3.0: `target/fmu/fmi3`)
+/// as `eigenmpc export --fmi 2,3` would, from the one binary at `binary`;
+/// returns the FMUs' model descriptions as `(file under modelDescription/,
+/// text)`.
 fn export_pair(ws: &Workspace, pair: &ShippedPair, binary: &Path) -> Result<Vec<(String, String)>> {
     let path = ws.root.join(pair.robot);
     let file = RobotFile::load(&path).with_context(|| format!("{}", path.display()))?;
@@ -290,6 +291,7 @@ fn export_pair(ws: &Workspace, pair: &ShippedPair, binary: &Path) -> Result<Vec<
         tau_max,
         chart_degree: 9,
         binary,
+        fmi3: true,
     };
     let out = ws.target.join("fmu");
     let n = pair.joints;
@@ -298,27 +300,29 @@ fn export_pair(ws: &Workspace, pair: &ShippedPair, binary: &Path) -> Result<Vec<
         |N, S, NP| export::export::<N, S>(&file.chain::<N>()?, &options, &out)?,
         otherwise bail!(eigenmpc::joints::unsupported(n))
     );
-    for path in [&written.controller.1, &written.plant.1, &written.ssp] {
+    for path in written.archives.iter().chain([&written.ssp]) {
         println!("wrote {}", path.display());
     }
-    written
-        .specs
-        .iter()
-        .map(|spec| {
-            let description = spec.description().map_err(anyhow::Error::msg)?;
-            Ok((
-                spec.model_name.clone(),
-                fmi2_slave::xml::model_description_xml(&description),
-            ))
-        })
-        .collect()
+    let mut descriptions = vec![];
+    for spec in &written.specs {
+        let description = spec.description().map_err(anyhow::Error::msg)?;
+        descriptions.push((
+            format!("{}.xml", spec.model_name),
+            fmi2_slave::xml::model_description_xml(&description),
+        ));
+        descriptions.push((
+            format!("fmi3/{}.xml", spec.model_name),
+            fmi3_slave::xml::model_description_xml(&description),
+        ));
+    }
+    Ok(descriptions)
 }
 
-/// Updates the checked-in model description; true if it changed.
-fn update_checked_in(ws: &Workspace, model_identifier: &str, xml: &str) -> Result<bool> {
-    let dir = ws.root.join("modelDescription");
-    std::fs::create_dir_all(&dir)?;
-    let path = dir.join(format!("{model_identifier}.xml"));
+/// Updates the checked-in model description `modelDescription/<file>`
+/// (`<id>.xml`, FMI 3.0: `fmi3/<id>.xml`); true if it changed.
+fn update_checked_in(ws: &Workspace, file: &str, xml: &str) -> Result<bool> {
+    let path = ws.root.join("modelDescription").join(file);
+    std::fs::create_dir_all(path.parent().context("modelDescription folder")?)?;
     let old = std::fs::read_to_string(&path).unwrap_or_default();
     if old == xml {
         return Ok(false);
@@ -408,9 +412,9 @@ fn main() -> Result<()> {
     }
     let host = archive::robot_binary_path(&ws.target.join("fmu"));
     for pair in SHIPPED {
-        for (model_identifier, xml) in export_pair(&ws, pair, &host)? {
-            if update_checked_in(&ws, &model_identifier, &xml)? {
-                println!("updated modelDescription/{model_identifier}.xml: commit it");
+        for (file, xml) in export_pair(&ws, pair, &host)? {
+            if update_checked_in(&ws, &file, &xml)? {
+                println!("updated modelDescription/{file}: commit it");
             }
         }
     }

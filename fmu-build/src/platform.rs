@@ -11,6 +11,9 @@ use std::path::{Path, PathBuf};
 pub struct Platform {
     /// FMI 2.0 name: the folder under `binaries/` (`linux64`, `win64`).
     pub fmi2: &'static str,
+    /// FMI 3.0 platform tuple: the folder under `binaries/` of an FMI 3.0
+    /// archive (`x86_64-linux`, `x86_64-windows`).
+    pub fmi3: &'static str,
     /// Rust target triple.
     pub target: &'static str,
     /// Built by the host's own toolchain (true) or cross-built with
@@ -31,6 +34,7 @@ pub struct Platform {
 /// 64-bit Linux on x86-64: the host's.
 pub const LINUX64: Platform = Platform {
     fmi2: "linux64",
+    fmi3: "x86_64-linux",
     target: "x86_64-unknown-linux-gnu",
     native: true,
     c_compiler: "gcc",
@@ -43,6 +47,7 @@ pub const LINUX64: Platform = Platform {
 /// Windows system libraries.
 pub const WIN64: Platform = Platform {
     fmi2: "win64",
+    fmi3: "x86_64-windows",
     target: "x86_64-pc-windows-gnu",
     native: false,
     c_compiler: "x86_64-w64-mingw32-gcc",
@@ -55,6 +60,26 @@ pub const WIN64: Platform = Platform {
 /// validate it).
 pub const PLATFORMS: &[&Platform] = &[&LINUX64, &WIN64];
 
+/// The FMI versions an archive can be written for (the one binary exports
+/// the functions of both).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FmiVersion {
+    /// FMI 2.0 Co-Simulation: `<name>.fmu`.
+    Fmi2,
+    /// FMI 3.0 Co-Simulation: `fmi3/<name>.fmu`.
+    Fmi3,
+}
+
+impl FmiVersion {
+    /// Where an archive of this version goes under the output folder `out`.
+    pub fn archive(self, out: &Path, model_identifier: &str) -> PathBuf {
+        match self {
+            FmiVersion::Fmi2 => out.join(format!("{model_identifier}.fmu")),
+            FmiVersion::Fmi3 => out.join("fmi3").join(format!("{model_identifier}.fmu")),
+        }
+    }
+}
+
 /// The environment variable that narrows the platforms `fmu-build` builds
 /// (comma-separated FMI 2.0 names, e.g. `linux64`); unset: all.
 pub const PLATFORMS_ENV: &str = "FMU_PLATFORMS";
@@ -65,11 +90,20 @@ impl Platform {
         format!("{}{lib_name}{}", self.library_prefix, self.library_suffix)
     }
 
-    /// The binary's path inside an FMU archive of `model_identifier`.
+    /// The binary's path inside an FMI 2.0 archive of `model_identifier`.
     pub fn archive_path(&self, model_identifier: &str) -> String {
+        self.archive_path_in(FmiVersion::Fmi2, model_identifier)
+    }
+
+    /// The binary's path inside an archive of FMI `version`.
+    pub fn archive_path_in(&self, version: FmiVersion, model_identifier: &str) -> String {
+        let folder = match version {
+            FmiVersion::Fmi2 => self.fmi2,
+            FmiVersion::Fmi3 => self.fmi3,
+        };
         format!(
-            "binaries/{}/{model_identifier}{}",
-            self.fmi2, self.library_suffix
+            "binaries/{folder}/{model_identifier}{}",
+            self.library_suffix
         )
     }
 

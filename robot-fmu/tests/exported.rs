@@ -219,7 +219,17 @@ fn an_instance_needs_its_resources_and_a_supported_joint_count() {
 
 #[test]
 fn the_shared_library_exports_the_fmi_functions_only() {
-    fmi2_slave::testing::assert_exports_fmi2_cs(&fmi2_slave::testing::test_cdylib(
+    // The 34 FMI 2.0 functions and the 75 of FMI 3.0, nothing else.
+    let exported = fmi2_slave::testing::assert_exports_fmi2_cs(&fmi2_slave::testing::test_cdylib(
         "eigenmpc_robot",
     ));
+    for name in fmi3_slave::FMI3_FUNCTIONS {
+        assert!(exported.iter().any(|e| e == name), "{name} not exported");
+    }
+    let foreign: Vec<&String> = exported
+        .iter()
+        .filter(|s| !s.starts_with("fmi2") && !s.starts_with("fmi3"))
+        .collect();
+    assert!(foreign.is_empty(), "{foreign:?}");
+    assert_eq!(exported.len(), 34 + fmi3_slave::FMI3_FUNCTIONS.len());
 }

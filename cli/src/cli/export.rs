@@ -41,6 +41,10 @@ pub struct ExportArgs {
     /// executable's folder).
     #[arg(long, value_name = "FILE")]
     binary: Option<PathBuf>,
+    /// FMI versions: 2 (always written: <NAME>EigenMPC.fmu, ..., coupled by the SSP) and 3
+    /// (also fmi3/<NAME>EigenMPC.fmu and fmi3/<NAME>Plant.fmu, FMI 3.0 Co-Simulation).
+    #[arg(long, value_delimiter = ',', default_value = "2", value_parser = clap::value_parser!(u8).range(2..=3))]
+    fmi: Vec<u8>,
 }
 
 /// Runs the subcommand for the file's joint count.
@@ -104,6 +108,7 @@ fn run_for<const N: usize, const S: usize>(
         tau_max,
         chart_degree: args.chart_degree,
         binary: &binary,
+        fmi3: args.fmi.contains(&3),
     };
     let written = export::<N, S>(system, &options, &args.out)?;
     println!(
@@ -113,7 +118,7 @@ fn run_for<const N: usize, const S: usize>(
         args.chart_degree,
         written.platforms.join(", ")
     );
-    for path in [&written.controller.1, &written.plant.1, &written.ssp] {
+    for path in written.archives.iter().chain([&written.ssp]) {
         println!("wrote {}", path.display());
     }
     Ok(())
