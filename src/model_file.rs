@@ -66,6 +66,16 @@ const PER_LINK: [&str; 11] = [
 ];
 const GLOBAL: [&str; 4] = ["g", "coulomb_sharpness", "Ir", "gr"];
 
+/// Joints of the robot of an optional parameter file: the file's links, and
+/// 2 (the paper's double pendulum) without one (the CLI's and the sweeps'
+/// convention).
+pub fn joint_count(path: Option<&Path>) -> Result<usize, ModelFileError> {
+    match path {
+        Some(path) => Ok(RobotFile::load(path)?.links()),
+        None => Ok(2),
+    }
+}
+
 impl RobotFile {
     /// Reads and checks a `.json`, `.yml` or `.yaml` file.
     pub fn load(path: impl AsRef<Path>) -> Result<Self, ModelFileError> {

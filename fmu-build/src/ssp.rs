@@ -22,8 +22,8 @@ pub struct SspSpec<'a> {
     pub joints: usize,
 }
 
-/// Start angle of every joint (rad), at rest: the paper's scenario start.
-pub const START_ANGLE: f64 = 0.05;
+pub use eigenmpc::mpc::closed_loop::START_ANGLE;
+
 /// Name of the parameter set with the start state (ecos: `init(parameter_set=...)`).
 pub const PARAMETER_SET: &str = "initialValues";
 /// Stop time of the default experiment (s).

@@ -420,6 +420,10 @@ pub fn summarise<const N: usize, const NX: usize>(
     }
 }
 
+/// Start angle of every joint (rad), at rest: the paper's scenario (and
+/// that of the sweeps, the robustness runs and the shipped SSPs).
+pub const START_ANGLE: f64 = 0.05;
+
 /// The true eigenmode of family `mode_index` at `energy` and its chart of
 /// the given degree (the paper uses 9): what the curved cost and the
 /// distance metric need.

@@ -119,10 +119,7 @@ impl ModelArgs {
     /// point-mass pendulum of `--m1 .. --g`. A count outside the joint-count
     /// table is an error.
     pub fn joint_count(&self) -> anyhow::Result<usize> {
-        match &self.model {
-            Some(path) => Ok(RobotFile::load(path)?.links()),
-            None => Ok(2),
-        }
+        Ok(eigenmpc::model_file::joint_count(self.model.as_deref())?)
     }
 
     /// Builds the `N`-joint robot, refusing non-physical parameters, bad

@@ -451,8 +451,7 @@ pub struct Setup<const N: usize> {
 /// Noise level the filter assumes for a clean sensor (rad, rad/s).
 pub const EKF_NOISE_FLOOR: f64 = 0.005;
 
-/// Every joint starts at this angle, at rest (rad): the paper's start.
-pub const START_ANGLE: f64 = 0.05;
+pub use eigenmpc::mpc::closed_loop::START_ANGLE;
 
 impl<const N: usize> Setup<N> {
     /// The controller FMU's default controller (curved, computed family,

@@ -43,10 +43,7 @@ use std::path::{Path, PathBuf};
 /// Scored window at the end of every run (s).
 pub const WINDOW: f64 = 5.0;
 
-/// The angle every joint starts from (rad), at rest, before the spec's
-/// values: the paper's start state (the plant FMU's own default is the
-/// chain hanging at rest, where the controller has nothing to do).
-pub const START_ANGLE: f64 = 0.05;
+pub use eigenmpc::mpc::closed_loop::START_ANGLE;
 
 /// `plant.q0[j] = START_ANGLE` for the `joints` joints.
 pub fn base_values(joints: usize) -> Vec<(String, f64)> {
@@ -190,12 +187,7 @@ impl Spec {
     /// Joints of the swept robot: the `model` file's, 2 (the paper's
     /// pendulum) without one.
     pub fn joint_count(&self) -> Result<usize, String> {
-        match &self.model {
-            Some(path) => RobotFile::load(path)
-                .map(|f| f.links())
-                .map_err(|e| e.to_string()),
-            None => Ok(2),
-        }
+        eigenmpc::model_file::joint_count(self.model.as_deref()).map_err(|e| e.to_string())
     }
 
     /// The swept names, in the order of the CSV columns.
@@ -423,9 +415,9 @@ pub trait SweepRun: Send + Sync {
 }
 
 /// A [`RunSetup`] with the sizes its closed loop needs.
-struct Sized<const N: usize, const S: usize, const NP: usize>(RunSetup<N>);
+struct SizedRun<const N: usize, const S: usize, const NP: usize>(RunSetup<N>);
 
-impl<const N: usize, const S: usize, const NP: usize> SweepRun for Sized<N, S, NP> {
+impl<const N: usize, const S: usize, const NP: usize> SweepRun for SizedRun<N, S, NP> {
     fn run(&self, duration: f64) -> Result<Metrics, String> {
         run::<N, S, NP>(&self.0, duration)
     }
@@ -442,7 +434,7 @@ pub fn setups(spec: &Spec, runs: &[Vec<(String, f64)>]) -> Result<Vec<Box<dyn Sw
             .enumerate()
             .map(|(i, run)| {
                 RunSetup::<N>::new(spec, run)
-                    .map(|s| Box::new(Sized::<N, S, NP>(s)) as Box<dyn SweepRun>)
+                    .map(|s| Box::new(SizedRun::<N, S, NP>(s)) as Box<dyn SweepRun>)
                     .map_err(|e| {
                         let values: Vec<String> =
                             run.iter().map(|(n, v)| format!("{n} = {v}")).collect();

@@ -40,6 +40,7 @@ impl<const N: usize> PrecomputedFamily<N> {
 
     /// Why this is not the family of `settings` on `system` (None: it is).
     pub fn mismatch(&self, settings: &Settings<N>, system: &PlanarChain<N>) -> Option<String> {
+        let wanted = settings.family_options(system);
         if self.model != *system.params() {
             Some("the model's parameters differ from the exported robot's".into())
         } else if self.mode != settings.mode {
@@ -48,12 +49,11 @@ impl<const N: usize> PrecomputedFamily<N> {
                 self.mode + 1,
                 settings.mode + 1
             ))
-        } else if self.options != settings.family_options(system) {
+        } else if self.options != wanted {
             Some(format!(
                 "it was computed up to {} J, the controller needs {} J (E_ref or \
                  family_energy_max changed)",
-                self.options.energy_max,
-                settings.family_options(system).energy_max
+                self.options.energy_max, wanted.energy_max
             ))
         } else {
             None
