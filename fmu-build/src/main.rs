@@ -1,23 +1,29 @@
 //! `fmu-build`: the packaging tool (xtask style).
 //!
 //! `cargo run -p fmu-build` release-builds the one FMU binary
-//! (`eigenmpc-robot-fmu`, stripped; its debug information is kept apart in
-//! `target/fmu/eigenmpc_robot.so.debug`) and writes every shipped pair of
-//! [`SHIPPED`] as an export of its robot file, exactly as `eigenmpc export`
-//! writes a user's robot: `target/fmu/<modelIdentifier>.fmu`
-//! (`modelDescription.xml` from the variable table and the robot,
-//! `binaries/linux64/<modelIdentifier>.so`, `resources/` with what the
-//! instance is and the controller's precomputed mode family,
-//! `documentation/index.html`), each loaded and stepped, and the closed loop
-//! as an SSP archive. It also copies each model description into the
-//! checked-in `modelDescription/`, release-builds the C library
-//! (`libeigenmpc_fmu.so`: the plain C API, [`C_LIBRARY`]), generates
-//! `include/eigenmpc.h` (the C API with cbindgen, config `cbindgen.toml`, and
-//! every shipped FMU's value-reference and enumeration constants from its
-//! variable table) next to the standard FMI 2.0 headers, and rewrites the
-//! README's FMU variable tables from the variable tables.
+//! (`eigenmpc-robot-fmu`, exporting the FMI 2.0 and FMI 3.0 functions) for
+//! every platform of `fmu_build::platform` (linux64 natively, stripped, its
+//! debug information kept apart in `target/fmu/eigenmpc_robot.so.debug`;
+//! win64 cross-built; `FMU_PLATFORMS` narrows the list) and writes every
+//! shipped pair of [`SHIPPED`] as an export of its robot file, exactly as
+//! `eigenmpc export --fmi 2,3` writes a user's robot:
+//! `target/fmu/<modelIdentifier>.fmu` (FMI 2.0) and
+//! `target/fmu/fmi3/<modelIdentifier>.fmu` (FMI 3.0), each with
+//! `modelDescription.xml` from the variable table and the robot, one binary
+//! per platform, `resources/` with what the instance is and the
+//! controller's precomputed mode family, and `documentation/index.html`;
+//! each archive is loaded and stepped before the next, and the closed loop
+//! goes into an SSP archive. It also copies each model description into the
+//! checked-in `modelDescription/` (`fmi3/` for FMI 3.0), builds the C library
+//! (`libeigenmpc_fmu.so`, the plain C API: [`C_LIBRARY`]) per platform into
+//! `target/fmu/c/<platform>/`, generates `include/eigenmpc.h` (the C API with
+//! cbindgen, config `cbindgen.toml`, and every shipped FMU's FMI 2.0
+//! value-reference and enumeration constants from its variable table) next
+//! to the standard FMI 2.0 headers, and rewrites the README's FMU variable
+//! tables from the variable tables.
 //!
-//! Adding a shipped FMU pair is a robot file and one row of [`SHIPPED`].
+//! Adding a shipped FMU pair is a robot file and one row of [`SHIPPED`]; a
+//! platform is one row of `fmu_build::platform::PLATFORMS`.
 
 use fmu_build::archive;
 use fmu_build::export::{self, ExportOptions};
@@ -60,6 +66,7 @@ const C_LIBRARY: Library = Library {
 const C_API_UNPREFIXED: &[&str] = &["EigenMpc", "EigenMpcConfig", "EigenMpcStepInfo"];
 /// Prefix of the C API's other items (its constants).
 const C_API_PREFIX: &str = "EIGENMPC_";
+
 struct Workspace {
     root: PathBuf,
     target: PathBuf,
