@@ -68,9 +68,10 @@ pub enum ModeError {
     /// The continuation used up its work limit
     /// ([`ContinuationOptions::max_evaluations`]).
     #[error(
-        "the {family} stopped at its work limit ({limit} integrator evaluations) at E = {reached:.4} J: \
-         the model's time scales are too far apart (a very light, heavy, long or stiff link) to \
-         compute its orbits in bounded time"
+        "the {family} cannot be continued beyond E = {reached:.4} J: it stopped at its work limit \
+         ({limit} integrator evaluations); its orbits need more integration than that (time \
+         scales far apart: a very light, heavy, long or stiff link; or an energy near the top of \
+         the potential, where the period grows without bound)"
     )]
     WorkLimit {
         /// Family name.
