@@ -48,12 +48,12 @@ pub fn write_fmu(
     let exe = opts.unix_permissions(0o755);
     zip.start_file("modelDescription.xml", opts)?;
     zip.write_all(xml.as_bytes())?;
+    // A platform this FMI version has no name for is left out.
     for binary in binaries {
-        zip.start_file(
-            binary.platform.archive_path_in(version, model_identifier),
-            exe,
-        )?;
-        zip.write_all(binary.bytes)?;
+        if let Some(path) = binary.platform.archive_path(version, model_identifier) {
+            zip.start_file(path, exe)?;
+            zip.write_all(binary.bytes)?;
+        }
     }
     zip.start_file("documentation/index.html", opts)?;
     zip.write_all(html.as_bytes())?;

@@ -56,8 +56,9 @@ pub struct Exported {
     pub specs: [ExportSpec; 2],
     /// Every archive written (controller and plant, per FMI version).
     pub archives: Vec<PathBuf>,
-    /// The platforms the FMUs carry a binary for (FMI 2.0 names).
-    pub platforms: Vec<&'static str>,
+    /// The platforms the FMUs carry a binary for, by name; those FMI 2.0
+    /// has no name for say "(FMI 3.0 only)".
+    pub platforms: Vec<String>,
 }
 
 /// The default energy of an export: 10 % of the potential energy with every
@@ -152,7 +153,13 @@ pub fn export<const N: usize, const S: usize>(
         ssp,
         specs: [controller, plant],
         archives,
-        platforms: binaries.iter().map(|(p, _)| p.fmi2).collect(),
+        platforms: binaries
+            .iter()
+            .map(|(p, _)| match p.fmi2 {
+                Some(_) => p.name.to_string(),
+                None => format!("{} (FMI 3.0 only)", p.name),
+            })
+            .collect(),
     })
 }
 
@@ -220,7 +227,7 @@ pub fn platform_binaries(host: &Path) -> Vec<(&'static Platform, PathBuf)> {
     for platform in &PLATFORMS[1..] {
         if let Some(dir) = robot_dir {
             let path = dir
-                .join(platform.fmi2)
+                .join(platform.name)
                 .join(platform.library(ROBOT_LIB_NAME));
             if path.is_file() {
                 found.push((*platform, path));

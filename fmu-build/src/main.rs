@@ -4,8 +4,9 @@
 //! (`eigenmpc-robot-fmu`, exporting the FMI 2.0 and FMI 3.0 functions) for
 //! every platform of `fmu_build::platform` (linux64 natively, stripped, its
 //! debug information kept apart in `target/fmu/eigenmpc_robot.so.debug`;
-//! win64 cross-built; `FMU_PLATFORMS` narrows the list) and writes every
-//! shipped pair of [`SHIPPED`] as an export of its robot file, exactly as
+//! win64 and aarch64-linux cross-built; `FMU_PLATFORMS` narrows the list)
+//! and writes every shipped pair of [`SHIPPED`] as an export of its robot
+//! file, exactly as
 //! `eigenmpc export --fmi 2,3` writes a user's robot:
 //! `target/fmu/<modelIdentifier>.fmu` (FMI 2.0) and
 //! `target/fmu/fmi3/<modelIdentifier>.fmu` (FMI 3.0), each with
@@ -138,8 +139,8 @@ fn cross_build(ws: &Workspace, library: &Library, platform: &Platform) -> Result
     {
         bail!(
             "{}: cross-building needs Debian's rustc-web, cargo-web, rust-web-src and {}: run              `bash scripts/ensure-cross-deps.sh` (as root), or build the host's only with              {PLATFORMS_ENV}=linux64",
-            platform.fmi2,
-            platform.c_compiler
+            platform.name,
+            platform.packages
         );
     }
     println!(
@@ -176,7 +177,7 @@ fn cross_build(ws: &Workspace, library: &Library, platform: &Platform) -> Result
         bail!(
             "cross build of {} for {} failed",
             library.package,
-            platform.fmi2
+            platform.name
         );
     }
     Ok(cross_target
@@ -264,7 +265,7 @@ fn c_library(ws: &Workspace, platform: &Platform) -> Result<PathBuf> {
     } else {
         cross_build(ws, &C_LIBRARY, platform)?
     };
-    let dir = ws.target.join("fmu").join("c").join(platform.fmi2);
+    let dir = ws.target.join("fmu").join("c").join(platform.name);
     std::fs::create_dir_all(&dir)?;
     let path = dir.join(platform.library(C_LIBRARY.lib_name));
     std::fs::copy(&built, &path).with_context(|| format!("copying {}", built.display()))?;
@@ -414,7 +415,7 @@ fn main() -> Result<()> {
         println!(
             "wrote {} (the binary of every FMU, shipped or exported, on {})",
             robot.display(),
-            p.fmi2
+            p.name
         );
     }
     let host = archive::robot_binary_path(&ws.target.join("fmu"));
@@ -427,7 +428,7 @@ fn main() -> Result<()> {
     }
     for p in &platforms {
         let path = c_library(&ws, p)?;
-        println!("wrote {} (the C library, {})", path.display(), p.fmi2);
+        println!("wrote {} (the C library, {})", path.display(), p.name);
     }
     let h = header(&ws)?;
     println!("wrote {}", h.display());

@@ -65,11 +65,19 @@ fn family_taken(lines: &[String], family: bool) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The host platform's binary in an archive of FMI `version` (the host is
+/// named in both versions).
+fn host_binary(version: FmiVersion, model_identifier: &str) -> String {
+    PLATFORMS[0]
+        .archive_path(version, model_identifier)
+        .expect("the host platform has a folder in every FMI version")
+}
+
 fn fmi2(dir: &Path, spec: &ExportSpec, family: bool) -> anyhow::Result<()> {
     use fmi2_slave::ffi;
     let guid = attribute(dir, "guid")?;
     let guid = guid.as_str();
-    let library = dir.join(PLATFORMS[0].archive_path_in(FmiVersion::Fmi2, &spec.model_name));
+    let library = dir.join(host_binary(FmiVersion::Fmi2, &spec.model_name));
     // SAFETY: the binary is ours (eigenmpc-robot-fmu): loading runs no
     // foreign initialisers.
     let lib = unsafe { ffi::Fmi2Binding::new(&library) }
@@ -139,7 +147,7 @@ fn fmi2(dir: &Path, spec: &ExportSpec, family: bool) -> anyhow::Result<()> {
 fn fmi3(dir: &Path, spec: &ExportSpec, family: bool) -> anyhow::Result<()> {
     use fmi3_slave::ffi;
     let token = std::ffi::CString::new(attribute(dir, "instantiationToken")?)?;
-    let library = dir.join(PLATFORMS[0].archive_path_in(FmiVersion::Fmi3, &spec.model_name));
+    let library = dir.join(host_binary(FmiVersion::Fmi3, &spec.model_name));
     // SAFETY: the binary is ours (eigenmpc-robot-fmu): loading runs no
     // foreign initialisers.
     let lib = unsafe { libloading::Library::new(&library) }
