@@ -12,20 +12,12 @@ use crate::model::Model;
 use crate::sink::{Fmi2Sink, ToFfi};
 use crate::state::{self, FmuState};
 use crate::variables::BaseType;
-use std::any::Any;
+use fmu_core::abi::{guarded, live_state, slice, slice_mut, store_state};
 use std::ffi::{CStr, c_char};
-use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::panic::catch_unwind;
 use std::ptr;
 
 const ERROR: ffi::fmi2Status = ffi::fmi2Status_fmi2Error;
-
-fn panic_message(payload: &(dyn Any + Send)) -> &str {
-    payload
-        .downcast_ref::<&str>()
-        .copied()
-        .or_else(|| payload.downcast_ref::<String>().map(|s| s.as_str()))
-        .unwrap_or("unknown panic")
-}
 
 /// Runs `body` on the instance behind `c`, catching panics.
 ///
@@ -37,51 +29,9 @@ unsafe fn call<M: Model>(
     func: &'static str,
     body: impl FnOnce(&mut Instance<M>) -> Status,
 ) -> ffi::fmi2Status {
-    if c.is_null() {
-        // No instance, so no logger to explain it.
-        return ERROR;
-    }
-    let p = c as *mut Instance<M>;
     // SAFETY: see the function's contract.
-    match catch_unwind(AssertUnwindSafe(|| body(unsafe { &mut *p }))) {
-        Ok(status) => status.to_ffi(),
-        Err(payload) => {
-            // SAFETY: the closure that held the borrow has been consumed.
-            let instance = unsafe { &mut *p };
-            let message = format!("{func}: internal error: {}", panic_message(&*payload));
-            instance.fail(&message).to_ffi()
-        }
-    }
-}
-
-/// A slice from a C array (`None` for a null pointer with `n > 0`).
-///
-/// # Safety
-/// A non-null `p` points to `n` valid elements.
-unsafe fn slice<'a, T>(p: *const T, n: usize) -> Option<&'a [T]> {
-    if n == 0 {
-        Some(&[])
-    } else if p.is_null() {
-        None
-    } else {
-        // SAFETY: see the function's contract.
-        Some(unsafe { std::slice::from_raw_parts(p, n) })
-    }
-}
-
-/// A mutable slice from a C array (`None` for a null pointer with `n > 0`).
-///
-/// # Safety
-/// A non-null `p` points to `n` writable elements.
-unsafe fn slice_mut<'a, T>(p: *mut T, n: usize) -> Option<&'a mut [T]> {
-    if n == 0 {
-        Some(&mut [])
-    } else if p.is_null() {
-        None
-    } else {
-        // SAFETY: see the function's contract.
-        Some(unsafe { std::slice::from_raw_parts_mut(p, n) })
-    }
+    unsafe { guarded(c as *mut Instance<M>, func, body, |inst, m| inst.fail(m)) }
+        .map_or(ERROR, |status| status.to_ffi())
 }
 
 fn null<M: Model>(instance: &mut Instance<M>, func: &str, what: &str) -> Status {
@@ -529,38 +479,8 @@ pub unsafe fn get_boolean_status<M: Model>(
     }
 }
 
-/// The live state behind a host's `fmi2FMUstate`, or the reason it is none.
-fn live_state<'a>(s: ffi::fmi2FMUstate) -> Result<&'a FmuState, &'static str> {
-    let p = s as *const FmuState;
-    if p.is_null() {
-        Err("argument FMUstate is a NULL pointer")
-    } else if !state::is_live(p) {
-        Err("FMUstate is not a live state of this FMU (freed, or from elsewhere)")
-    } else {
-        // SAFETY: live states are boxes this library allocated and has not freed.
-        Ok(unsafe { &*p })
-    }
-}
-
-/// Stores `saved` in the host's `*out`: into the live state already there
-/// (FMI 2.0: a non-NULL `*FMUstate` is overwritten), else a new one.
-///
-/// # Safety
-/// `out` is non-null and writable.
-unsafe fn store_state(out: *mut ffi::fmi2FMUstate, saved: FmuState) -> Result<(), &'static str> {
-    // SAFETY: see the function's contract.
-    let current = unsafe { *out } as *mut FmuState;
-    if current.is_null() {
-        unsafe { *out = state::into_raw(saved) as ffi::fmi2FMUstate };
-        Ok(())
-    } else if state::is_live(current) {
-        // SAFETY: live, allocated by this library.
-        unsafe { *current = saved };
-        Ok(())
-    } else {
-        Err("*FMUstate is neither NULL nor a live state of this FMU")
-    }
-}
+/// The name of the FMU-state argument in FMI 2.0, for messages.
+const STATE: &str = "FMUstate";
 
 /// `fmi2GetFMUstate`.
 ///
@@ -577,7 +497,7 @@ pub unsafe fn get_fmu_state<M: Model>(
                 return null(inst, F, "FMUstate");
             }
             match inst.save_state(F) {
-                Ok(saved) => match store_state(s, saved) {
+                Ok(saved) => match store_state(s, saved, STATE) {
                     Ok(()) => Status::Ok,
                     Err(e) => inst.state_argument_error(&format!("{F}: {e}")),
                 },
@@ -597,7 +517,7 @@ pub unsafe fn set_fmu_state<M: Model>(
 ) -> ffi::fmi2Status {
     const F: &str = "fmi2SetFMUstate";
     unsafe {
-        call::<M>(c, F, |inst| match live_state(s) {
+        call::<M>(c, F, |inst| match live_state(s, STATE) {
             Ok(saved) => {
                 let saved = saved.clone();
                 inst.restore_state(F, &saved)
@@ -652,7 +572,7 @@ pub unsafe fn serialized_fmu_state_size<M: Model>(
             if size.is_null() {
                 return null(inst, F, "size");
             }
-            match live_state(s) {
+            match live_state(s, STATE) {
                 Ok(saved) => {
                     *size = saved.bytes().len();
                     inst.state_call_ok(F)
@@ -677,7 +597,7 @@ pub unsafe fn serialize_fmu_state<M: Model>(
     const F: &str = "fmi2SerializeFMUstate";
     unsafe {
         call::<M>(c, F, |inst| {
-            let saved = match live_state(s) {
+            let saved = match live_state(s, STATE) {
                 Ok(saved) => saved,
                 Err(e) => return inst.state_argument_error(&format!("{F}: {e}")),
             };
@@ -718,7 +638,7 @@ pub unsafe fn deserialize_fmu_state<M: Model>(
                 return null(inst, F, "serializedState");
             };
             match inst.deserialize_state(F, input) {
-                Ok(saved) => match store_state(s, saved) {
+                Ok(saved) => match store_state(s, saved, STATE) {
                     Ok(()) => Status::Ok,
                     Err(e) => inst.state_argument_error(&format!("{F}: {e}")),
                 },

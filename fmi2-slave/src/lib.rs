@@ -8,7 +8,7 @@
 //!
 //! - [`instance`]: the FMI 2.0 state machine (instantiated, initialization
 //!   mode, step complete, step failed, terminated, error) and argument
-//!   checks around a [`Model`];
+//!   checks around a [`Model`], on fmu-core's version-neutral instance core;
 //! - [`xml`]: `modelDescription.xml` (FMI 2.0 schema), the GUID and the
 //!   documentation page;
 //! - [`sink`]: the host's `fmi2CallbackLogger` as the core logger's sink;

@@ -11,16 +11,13 @@
 //! parameters): those calls are errors.
 
 use crate::layout::{self, Fmi3Type, Layout};
-use fmu_core::logger::{Category, Logger, Status};
+pub use fmu_core::instance::MAX_START_TIME;
+use fmu_core::instance::{Core, Dialect};
+use fmu_core::logger::{Logger, Status};
 pub use fmu_core::model::{Context, Experiment, Model, ModelError, State};
-use fmu_core::state::{self, FmuState, ModelSnapshot, Snapshot};
-use fmu_core::values::Values;
-use fmu_core::variables::compact;
 use fmu_core::variables::{Causality, Initial, ModelDescription, Value, Variability};
+use std::ops::{Deref, DerefMut};
 use std::path::PathBuf;
-
-/// Largest `|startTime|` accepted (s): time steps of 1 us still resolve.
-pub const MAX_START_TIME: f64 = 1e9;
 
 /// The FMI 3.0 name of a state, for messages.
 pub fn state_name(s: State) -> &'static str {
@@ -43,53 +40,36 @@ pub struct StepOutcome {
     pub last_successful_time: f64,
 }
 
-/// One instance of model `M` with its state machine.
-pub struct Instance<M: Model> {
-    log: Logger,
-    description: ModelDescription,
-    layout: Layout,
-    /// The FMU's `resources/` folder (from `resourcePath`).
-    resources: Option<PathBuf>,
-    token: String,
-    values: Values,
-    state: State,
-    model: Option<M>,
-    /// The values `model` was initialized from (a saved state rebuilds the
-    /// model from them in a fresh instance).
-    initial_values: Option<Vec<Value>>,
-    /// In initialization mode: `model` reflects the current values.
-    model_current: bool,
-    experiment: Experiment,
-    time: f64,
-    last_successful_time: f64,
-    terminate_requested: bool,
-}
-
-// Instances may be driven from any thread (one at a time).
-const _: () = {
-    const fn assert_send<T: Send>() {}
-    struct Probe;
-    impl Model for Probe {
-        fn description() -> ModelDescription {
-            unreachable!()
-        }
-        fn initialize(_: &mut Values, _: &Context) -> Result<Self, ModelError> {
-            unreachable!()
-        }
-        fn do_step(
-            &mut self,
-            _: &mut Values,
-            _: f64,
-            _: f64,
-            _: &Context,
-        ) -> Result<(), ModelError> {
-            unreachable!()
-        }
-    }
-    assert_send::<Instance<Probe>>();
+/// FMI 3.0's words in the instance's messages.
+static FMI3: Dialect = Dialect {
+    state_name,
+    state_word: "",
+    can_save_state: "canGetAndSetFMUState",
+    token_name: "instantiationToken",
+    initialized: "initialization done, entered Step Mode",
 };
 
-type CallResult = Result<Status, String>;
+/// One instance of model `M` with its state machine: the version-neutral
+/// [`Core`] (values, state, model, clock, FMU state save and restore, which
+/// it derefs to), the array layout of its variables and the FMI 3.0 calls
+/// around them.
+pub struct Instance<M: Model> {
+    core: Core<M>,
+    layout: Layout,
+}
+
+impl<M: Model> Deref for Instance<M> {
+    type Target = Core<M>;
+    fn deref(&self) -> &Core<M> {
+        &self.core
+    }
+}
+
+impl<M: Model> DerefMut for Instance<M> {
+    fn deref_mut(&mut self) -> &mut Core<M> {
+        &mut self.core
+    }
+}
 
 const READABLE: &[State] = &[
     State::InitializationMode,
@@ -116,122 +96,27 @@ impl<M: Model> Instance<M> {
     /// [`Model::description_for`] it, `token` must be its instantiation
     /// token. Logs and returns `None` otherwise.
     pub fn new(log: Logger, token: &str, resources: Option<PathBuf>) -> Option<Self> {
-        const F: &str = "fmi3InstantiateCoSimulation";
-        let description = match M::description_for(resources.as_deref()) {
-            Ok(d) => d,
-            Err(e) => {
-                log.error(&format!("{F}: {e}"));
-                return None;
-            }
-        };
-        if let Err(e) = description.validate() {
-            log.error(&format!("{F}: invalid variable table: {e}"));
-            return None;
-        }
-        let expected = instantiation_token(&description);
-        if token != expected {
-            log.error(&format!(
-                "{F}: instantiationToken {token} does not match this binary's {expected} \
-                 (modelDescription.xml and binary come from different builds)"
-            ));
-            return None;
-        }
-        log.event(&format!(
-            "{F}: instance of {} created",
-            description.model_name
-        ));
-        let values = Values::new(&description);
-        let layout = Layout::new(&description);
-        Some(Self {
+        let core = Core::new(
+            "fmi3InstantiateCoSimulation",
             log,
-            description,
-            layout,
+            token,
             resources,
-            token: expected,
-            values,
-            state: State::Instantiated,
-            model: None,
-            initial_values: None,
-            model_current: false,
-            experiment: Experiment::default(),
-            time: 0.0,
-            last_successful_time: 0.0,
-            terminate_requested: false,
-        })
+            instantiation_token,
+            &FMI3,
+        )?;
+        let layout = Layout::new(&core.description);
+        Some(Self { core, layout })
     }
 
-    /// The current state.
-    pub fn state(&self) -> State {
-        self.state
-    }
-
-    /// The logger (for messages outside a call).
-    pub fn logger(&self) -> &Logger {
-        &self.log
-    }
-
-    /// The variable table.
-    pub fn description(&self) -> &ModelDescription {
-        &self.description
-    }
-
-    /// The FMI 3.0 variables.
+    /// The variables as FMI 3.0 sees them (arrays).
     pub fn layout(&self) -> &Layout {
         &self.layout
     }
 
-    /// The model, once initialized.
-    pub fn model(&self) -> Option<&M> {
-        self.model.as_ref()
-    }
-
-    /// Current communication time.
-    pub fn time(&self) -> f64 {
-        self.time
-    }
-
-    /// Finishes a call: an error is logged and moves the instance to the
-    /// error state; a warning logged during the call upgrades `fmi3OK`.
-    fn conclude(&mut self, result: CallResult) -> Status {
-        let warned = self.log.take_warned();
-        match result {
-            Ok(Status::Ok) if warned => Status::Warning,
-            Ok(s) => s,
-            Err(message) => {
-                self.log.error(&message);
-                self.state = State::Error;
-                Status::Error
-            }
-        }
-    }
-
-    /// Reports a failure found outside the instance methods (null pointer,
-    /// panic): logs it and enters the error state.
-    pub fn fail(&mut self, message: &str) -> Status {
-        self.conclude(Err(message.to_string()))
-    }
-
-    fn require(&self, func: &str, allowed: &[State]) -> Result<(), String> {
-        if allowed.contains(&self.state) {
-            Ok(())
-        } else {
-            let names: Vec<&str> = allowed.iter().map(|&s| state_name(s)).collect();
-            Err(format!(
-                "{func}: not allowed in {} (allowed in: {})",
-                state_name(self.state),
-                names.join(", ")
-            ))
-        }
-    }
-
     /// `fmi3SetDebugLogging`.
     pub fn set_debug_logging(&mut self, on: bool, categories: &[&str]) -> Status {
-        let r = self
-            .log
-            .set_debug_logging(on, categories)
-            .map(|()| Status::Ok)
-            .map_err(|e| format!("fmi3SetDebugLogging: {e}"));
-        self.conclude(r)
+        self.core
+            .set_debug_logging("fmi3SetDebugLogging", on, categories)
     }
 
     /// `fmi3EnterInitializationMode`: the experiment (FMI 2.0's
@@ -243,106 +128,24 @@ impl<M: Model> Instance<M> {
         stop_time: Option<f64>,
     ) -> Status {
         const F: &str = "fmi3EnterInitializationMode";
-        let r = (|| {
-            self.require(F, &[State::Instantiated])?;
-            self.log.trace(|| {
-                format!("{F}(tolerance = {tolerance:?}, startTime = {start_time}, stopTime = {stop_time:?})")
-            });
-            if !(start_time.is_finite() && start_time.abs() <= MAX_START_TIME) {
-                return Err(format!(
-                    "{F}: startTime = {start} must be finite and within \
-                     +-{MAX_START_TIME:e} s (beyond, a double cannot resolve the FMUs' time steps)",
-                    start = compact(start_time)
-                ));
-            }
-            if let Some(tol) = tolerance
-                && !(tol.is_finite() && tol > 0.0)
-            {
-                return Err(format!(
-                    "{F}: tolerance = {} must be finite and > 0",
-                    compact(tol)
-                ));
-            }
-            if let Some(stop) = stop_time
-                && !(stop.is_finite() && stop >= start_time)
-            {
-                return Err(format!(
-                    "{F}: stopTime = {} must be finite and >= startTime = {}",
-                    compact(stop),
-                    compact(start_time)
-                ));
-            }
-            self.experiment = Experiment {
-                tolerance,
-                start_time,
-                stop_time,
-            };
-            self.state = State::InitializationMode;
-            self.time = start_time;
-            self.last_successful_time = start_time;
-            self.model_current = false;
-            self.log.event("entered Initialization Mode");
-            Ok(Status::Ok)
-        })();
+        let r = self
+            .core
+            .set_experiment(F, tolerance, start_time, stop_time)
+            .and_then(|()| self.core.enter_initialization(F))
+            .map(|()| Status::Ok);
         self.conclude(r)
-    }
-
-    fn compute_initial(&mut self, func: &str) -> Result<(), String> {
-        let ctx = Context {
-            log: &self.log,
-            experiment: &self.experiment,
-            resources: self.resources.as_deref(),
-        };
-        let initial_values = self.values.all().to_vec();
-        let model = M::initialize(&mut self.values, &ctx).map_err(|e| format!("{func}: {e}"))?;
-        self.model = Some(model);
-        self.initial_values = Some(initial_values);
-        self.model_current = true;
-        Ok(())
     }
 
     /// `fmi3ExitInitializationMode`: builds the model (parameter
     /// validation), computes the outputs and enters Step Mode.
     pub fn exit_initialization_mode(&mut self) -> Status {
-        const F: &str = "fmi3ExitInitializationMode";
-        let r = (|| {
-            self.require(F, &[State::InitializationMode])?;
-            if !self.model_current {
-                self.compute_initial(F)?;
-            }
-            self.state = State::StepComplete;
-            self.terminate_requested = false;
-            self.log.event("initialization done, entered Step Mode");
-            Ok(Status::Ok)
-        })();
-        self.conclude(r)
+        self.core
+            .exit_initialization_mode("fmi3ExitInitializationMode")
     }
 
     /// `fmi3Terminate`.
     pub fn terminate(&mut self) -> Status {
-        let r = self
-            .require("fmi3Terminate", &[State::StepComplete, State::StepFailed])
-            .map(|()| {
-                self.state = State::Terminated;
-                self.log.event("terminated");
-                Status::Ok
-            });
-        self.conclude(r)
-    }
-
-    /// `fmi3Reset`: back to Instantiated with the start values.
-    pub fn reset(&mut self) -> Status {
-        self.values = Values::new(&self.description);
-        self.model = None;
-        self.initial_values = None;
-        self.model_current = false;
-        self.experiment = Experiment::default();
-        self.time = 0.0;
-        self.last_successful_time = 0.0;
-        self.terminate_requested = false;
-        self.state = State::Instantiated;
-        self.log.event("reset to the start values");
-        self.conclude(Ok(Status::Ok))
+        self.core.terminate("fmi3Terminate")
     }
 
     /// The variable of `vr` if it has type `ty` (index into the layout).
@@ -383,7 +186,7 @@ impl<M: Model> Instance<M> {
                 let v = &self.layout.variables[self.lookup(func, ty, vr)?];
                 total += v.len();
                 needs_model |= v
-                    .first(&self.description)
+                    .first(&self.core.description)
                     .is_some_and(|first| first.effective_initial() == Some(Initial::Calculated));
             }
             if total != n_values {
@@ -391,18 +194,21 @@ impl<M: Model> Instance<M> {
                     "{func}: nValues = {n_values}, the value references have {total} values"
                 ));
             }
-            if self.state == State::InitializationMode && needs_model && !self.model_current {
-                self.compute_initial(func)?;
+            if self.core.state == State::InitializationMode
+                && needs_model
+                && !self.core.model_current
+            {
+                self.core.compute_initial(func)?;
             }
             let mut k = 0;
             for &vr in vrs {
                 let v = &self.layout.variables[self.lookup(func, ty, vr)?];
                 if v.is_time() {
-                    write(k, Value::Real(self.time));
+                    write(k, Value::Real(self.core.time));
                     k += 1;
                 }
                 for i in v.elements.clone() {
-                    write(k, self.values.at(i));
+                    write(k, self.core.values.at(i));
                     k += 1;
                 }
             }
@@ -438,36 +244,36 @@ impl<M: Model> Instance<M> {
             let mut k = 0;
             for &vr in vrs {
                 let v = &self.layout.variables[self.lookup(func, ty, vr)?];
-                let Some(first) = v.first(&self.description) else {
+                let Some(first) = v.first(&self.core.description) else {
                     return Err(format!(
                         "{func}: {} (value reference {vr}) is the independent variable: \
                          it cannot be set",
                         v.name
                     ));
                 };
-                if !layout::settable(first, self.state) {
+                if !layout::settable(first, self.core.state) {
                     return Err(format!(
                         "{func}: {} (value reference {vr}, causality {:?}, variability {:?}) \
                          cannot be set in {}",
                         v.name,
                         first.causality,
                         first.variability,
-                        state_name(self.state)
+                        state_name(self.core.state)
                     ));
                 }
                 for i in v.elements.clone() {
                     let x = value(k).map_err(|e| {
                         format!(
                             "{func}: rejected: {}: {e}",
-                            self.description.variables[i].name
+                            self.core.description.variables[i].name
                         )
                     })?;
-                    self.description.variables[i]
+                    self.core.description.variables[i]
                         .check_value(x)
                         .map_err(|e| format!("{func}: rejected: {e}"))?;
                     k += 1;
                 }
-                tunables |= self.state == State::StepComplete
+                tunables |= self.core.state == State::StepComplete
                     && first.causality == Causality::Parameter
                     && first.variability == Variability::Tunable;
             }
@@ -476,7 +282,7 @@ impl<M: Model> Instance<M> {
             if tunables {
                 for &vr in vrs {
                     let v = &self.layout.variables[self.lookup(func, ty, vr)?];
-                    backup.extend(v.elements.clone().map(|i| (i, self.values.at(i))));
+                    backup.extend(v.elements.clone().map(|i| (i, self.core.values.at(i))));
                 }
             }
             let mut k = 0;
@@ -485,29 +291,13 @@ impl<M: Model> Instance<M> {
                     .elements
                     .clone();
                 for i in elements {
-                    self.values.set_at(i, value(k)?);
+                    self.core.values.set_at(i, value(k)?);
                     k += 1;
                 }
             }
-            self.model_current &= self.state == State::StepComplete;
+            self.core.model_current &= self.core.state == State::StepComplete;
             if tunables {
-                let ctx = Context {
-                    log: &self.log,
-                    experiment: &self.experiment,
-                    resources: self.resources.as_deref(),
-                };
-                let model = self
-                    .model
-                    .as_mut()
-                    .ok_or_else(|| format!("{func}: no model in Step Mode"))?;
-                if let Err(e) = model.update_tunables(&mut self.values, &ctx) {
-                    for (i, old) in backup {
-                        self.values.set_at(i, old);
-                    }
-                    return Err(format!("{func}: tunable parameter change rejected: {e}"));
-                }
-                self.log
-                    .event(&format!("{func}: tunable parameters updated"));
+                self.core.apply_tunables(func, backup)?;
             }
             Ok(Status::Ok)
         })();
@@ -551,251 +341,14 @@ impl<M: Model> Instance<M> {
 
     /// `fmi3DoStep`: advances from `t` to `t + h`.
     pub fn do_step(&mut self, t: f64, h: f64) -> (Status, StepOutcome) {
-        const F: &str = "fmi3DoStep";
-        let r = (|| {
-            self.require(F, &[State::StepComplete])?;
-            self.log.trace(|| {
-                format!("{F}(currentCommunicationPoint = {t}, communicationStepSize = {h})")
-            });
-            if !(h.is_finite() && h > 0.0) {
-                return Err(format!(
-                    "{F}: communicationStepSize = {} must be finite and > 0",
-                    compact(h)
-                ));
-            }
-            if t + h == t {
-                return Err(format!(
-                    "{F}: communicationStepSize = {} does not advance the time t = {} \
-                     in double precision",
-                    compact(h),
-                    compact(t)
-                ));
-            }
-            if !t.is_finite() || (t - self.time).abs() > 1e-8 * t.abs().max(1.0) {
-                return Err(format!(
-                    "{F}: currentCommunicationPoint = {} differs from the FMU's time {} \
-                     (rolling back is not supported)",
-                    compact(t),
-                    compact(self.time)
-                ));
-            }
-            let ctx = Context {
-                log: &self.log,
-                experiment: &self.experiment,
-                resources: self.resources.as_deref(),
-            };
-            let model = self
-                .model
-                .as_mut()
-                .ok_or_else(|| format!("{F}: no model in Step Mode"))?;
-            match model.do_step(&mut self.values, t, h, &ctx) {
-                Ok(()) => {
-                    self.time = t + h;
-                    self.last_successful_time = self.time;
-                    Ok(Status::Ok)
-                }
-                Err(ModelError::Discard {
-                    message,
-                    last_successful_time,
-                }) => {
-                    self.state = State::StepFailed;
-                    self.time = last_successful_time;
-                    self.last_successful_time = last_successful_time;
-                    self.terminate_requested = true;
-                    self.log.log(
-                        Category::StatusWarning,
-                        Status::Discard,
-                        &format!("{F}: step discarded at t = {last_successful_time}: {message}"),
-                    );
-                    Ok(Status::Discard)
-                }
-                Err(ModelError::Error(message)) => Err(format!("{F}: {message}")),
-            }
-        })();
+        let r = self.core.step("fmi3DoStep", t, h);
         let status = self.conclude(r);
         (
             status,
             StepOutcome {
-                terminate_simulation: self.terminate_requested,
-                last_successful_time: self.last_successful_time,
+                terminate_simulation: self.core.terminate_requested,
+                last_successful_time: self.core.last_successful_time,
             },
         )
-    }
-
-    /// A function this FMU does not support: `fmi3Error`.
-    pub fn unsupported(&mut self, func: &str, why: &str) -> Status {
-        self.conclude(Err(format!("{func}: not supported: {why}")))
-    }
-}
-
-/// FMU state save and restore (fmu-core's `state` has the byte form, the
-/// same as under FMI 2.0).
-impl<M: Model> Instance<M> {
-    fn require_state_support(&self, func: &str) -> Result<(), String> {
-        if self.description.can_save_state {
-            Ok(())
-        } else {
-            Err(format!(
-                "{func}: not supported: canGetAndSetFMUState is false"
-            ))
-        }
-    }
-
-    /// `fmi3GetFMUState` (and the state `fmi3SerializeFMUState` writes):
-    /// the serialized state of this instance. Allowed in every state.
-    pub fn save_state(&mut self, func: &str) -> Result<FmuState, Status> {
-        let r = (|| {
-            self.require_state_support(func)?;
-            // In initialization mode the model is rebuilt when needed (it
-            // is a function of the values); after it, it carries the run.
-            let model = match (&self.model, &self.initial_values) {
-                (Some(model), Some(initial)) if self.state != State::InitializationMode => {
-                    Some(ModelSnapshot {
-                        initial_values: initial.clone(),
-                        state: model.save_state().map_err(|e| format!("{func}: {e}"))?,
-                    })
-                }
-                _ => None,
-            };
-            let snapshot = Snapshot {
-                state: self.state,
-                values: self.values.all().to_vec(),
-                experiment: self.experiment,
-                time: self.time,
-                last_successful_time: self.last_successful_time,
-                terminate_requested: self.terminate_requested,
-                model,
-            };
-            let bytes = state::encode_snapshot(&self.token, &snapshot)
-                .map_err(|e| format!("{func}: {e}"))?;
-            Ok(FmuState { bytes })
-        })();
-        match r {
-            Ok(saved) => {
-                self.log.event(&format!(
-                    "{func}: state at t = {} saved ({} bytes)",
-                    self.time,
-                    saved.bytes.len()
-                ));
-                self.conclude(Ok(Status::Ok));
-                Ok(saved)
-            }
-            Err(e) => Err(self.conclude(Err(e))),
-        }
-    }
-
-    /// Decodes and checks a serialized state of this FMU (header, payload,
-    /// the values against the variable table).
-    fn decode_state(&self, bytes: &[u8]) -> Result<(Snapshot, Values), String> {
-        let snapshot: Snapshot = state::decode_snapshot(&self.token, bytes)?;
-        let values = Values::from_saved(&self.description, &snapshot.values)
-            .map_err(|e| format!("malformed state values: {e}"))?;
-        let needs_model = matches!(
-            snapshot.state,
-            State::StepComplete | State::StepFailed | State::Terminated
-        );
-        if needs_model && snapshot.model.is_none() {
-            return Err(format!(
-                "malformed state: {} without its model",
-                state_name(snapshot.state)
-            ));
-        }
-        if let Some(m) = &snapshot.model {
-            Values::from_saved(&self.description, &m.initial_values)
-                .map_err(|e| format!("malformed initial values: {e}"))?;
-        }
-        if !(snapshot.time.is_finite() && snapshot.last_successful_time.is_finite()) {
-            return Err("malformed state: time is not finite".into());
-        }
-        Ok((snapshot, values))
-    }
-
-    /// `fmi3DeserializeFMUState`: a state from its serialized form, checked
-    /// (a buffer of another FMU, format version, or a corrupt one is an error).
-    pub fn deserialize_state(&mut self, func: &str, bytes: &[u8]) -> Result<FmuState, Status> {
-        let r = self
-            .require_state_support(func)
-            .and_then(|()| self.decode_state(bytes).map_err(|e| format!("{func}: {e}")));
-        match r {
-            Ok(_) => {
-                self.conclude(Ok(Status::Ok));
-                Ok(FmuState {
-                    bytes: bytes.to_vec(),
-                })
-            }
-            Err(e) => Err(self.conclude(Err(e))),
-        }
-    }
-
-    /// `fmi3SetFMUState`: continues from `saved` (also after `fmi3Error`).
-    /// The model is restored in place when it was initialized from the same
-    /// values in the same experiment, else rebuilt from them first.
-    pub fn restore_state(&mut self, func: &str, saved: &FmuState) -> Status {
-        let r = (|| {
-            self.require_state_support(func)?;
-            let (snapshot, values) = self
-                .decode_state(&saved.bytes)
-                .map_err(|e| format!("{func}: {e}"))?;
-            let ctx = Context {
-                log: &self.log,
-                experiment: &snapshot.experiment,
-                resources: self.resources.as_deref(),
-            };
-            let model = match &snapshot.model {
-                None => None,
-                Some(m) => {
-                    let same = self.initial_values.as_ref() == Some(&m.initial_values)
-                        && self.experiment == snapshot.experiment;
-                    let mut model = match self.model.take() {
-                        Some(model) if same => model,
-                        current => {
-                            // A failed rebuild leaves the current model.
-                            self.model = current;
-                            let mut initial =
-                                Values::from_saved(&self.description, &m.initial_values)?;
-                            M::initialize(&mut initial, &ctx)
-                                .map_err(|e| format!("{func}: rebuilding the model: {e}"))?
-                        }
-                    };
-                    if let Err(e) = model.restore_state(&m.state, &values, &ctx) {
-                        // Keep the model so that the instance can still be
-                        // reset; the error state forbids stepping it.
-                        self.model = Some(model);
-                        self.initial_values = Some(m.initial_values.clone());
-                        return Err(format!("{func}: {e}"));
-                    }
-                    Some(model)
-                }
-            };
-            self.model_current = model.is_some();
-            self.model = model;
-            self.initial_values = snapshot.model.map(|m| m.initial_values);
-            self.values = values;
-            self.state = snapshot.state;
-            self.experiment = snapshot.experiment;
-            self.time = snapshot.time;
-            self.last_successful_time = snapshot.last_successful_time;
-            self.terminate_requested = snapshot.terminate_requested;
-            self.log.event(&format!(
-                "{func}: state at t = {} restored ({})",
-                self.time,
-                state_name(self.state)
-            ));
-            Ok(Status::Ok)
-        })();
-        self.conclude(r)
-    }
-
-    /// A state call with a bad argument (NULL, a pointer that is not a live
-    /// state, a buffer too small): `fmi3Error` with `message`.
-    pub fn state_argument_error(&mut self, message: &str) -> Status {
-        self.conclude(Err(message.to_string()))
-    }
-
-    /// A successful call that needs no instance data (`fmi3FreeFMUState`,
-    /// `fmi3SerializedFMUStateSize`, `fmi3SerializeFMUState`).
-    pub fn state_call_ok(&mut self, func: &str) -> Status {
-        let r = self.require_state_support(func).map(|()| Status::Ok);
-        self.conclude(r)
     }
 }

@@ -12,7 +12,8 @@
 //!   all types, and the independent variable `time` is added;
 //! - [`instance`]: the FMI 3.0 Co-Simulation state machine (instantiated,
 //!   initialization mode, step mode, terminated, error; no event mode) and
-//!   argument checks around a [`Model`];
+//!   argument checks around a [`Model`], on fmu-core's version-neutral
+//!   instance core;
 //! - [`xml`]: `modelDescription.xml` (FMI 3.0 schema);
 //! - [`sink`]: the host's `fmi3LogMessageCallback` as the core logger's sink;
 //! - [`abi`]: the C entry points, generic over the model, with null checks

@@ -5,7 +5,8 @@
 //! declarative variable table with its generators, the FMU-state codec,
 //! logging and resource folders. An FMI version is a sibling crate on top
 //! (`fmi2-slave`: the FMI 2.0 state machine, C functions, XML and headers;
-//! FMI 3.0 next), so a model written against this crate runs under either.
+//! `fmi3-slave` the same for FMI 3.0), so a model written against this crate
+//! runs under either.
 //!
 //! - [`model`]: the [`Model`] trait, its [`Context`] and errors;
 //! - [`variables`]: [`ModelDescription`], [`Variable`] and their types;
@@ -13,11 +14,18 @@
 //! - [`table`]: declarative tables parameterised by the number of joints,
 //!   from which the variables, value references, settings, C constants and
 //!   Markdown tables follow;
+//! - [`abi`]: the C entry points' helpers (slices, panics caught, FMU-state
+//!   pointers);
+//! - [`instance`]: the version-neutral half of an instance ([`instance::Core`]):
+//!   values, life-cycle state, model and clock, the transitions both
+//!   versions share and FMU state save / restore;
 //! - [`state`]: FMU state save and restore, and its versioned byte form;
 //! - [`logger`]: the log categories and their filter, over a [`LogSink`]
 //!   that each FMI version implements with its host callback;
 //! - [`resources`]: the resource location URI as a folder.
 
+pub mod abi;
+pub mod instance;
 pub mod logger;
 pub mod model;
 pub mod resources;

@@ -28,17 +28,23 @@ pub enum State {
     Error,
 }
 
-impl fmt::Display for State {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let s = match self {
+impl State {
+    /// The FMI 2.0 name of the state (`stepComplete`, ...).
+    pub fn name(self) -> &'static str {
+        match self {
             State::Instantiated => "instantiated",
             State::InitializationMode => "initializationMode",
             State::StepComplete => "stepComplete",
             State::StepFailed => "stepFailed",
             State::Terminated => "terminated",
             State::Error => "error",
-        };
-        f.write_str(s)
+        }
+    }
+}
+
+impl fmt::Display for State {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
     }
 }
 
