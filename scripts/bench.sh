@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Regenerates docs/speed.md (README "Speed"): the per-sample times of
-# `bench_mpc` with the CPU they were measured on and same-run ratios, and the
-# instruction counts per RTI sample (callgrind), which do not depend on the
-# machine. `bash scripts/bench.sh [OUT]` (default docs/speed.md); installs
+# `bench_mpc` with the CPU they were measured on and same-run ratios (the
+# robots of robots/ first), the instruction counts per RTI sample
+# (callgrind), which do not depend on the machine, and the first sample's
+# start-up on the laboratory robots (examples/startup.rs). `bash scripts/bench.sh [OUT]` (default docs/speed.md); installs
 # valgrind with apt when it is missing and you are root.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -11,7 +12,7 @@ source scripts/ensure-build-deps.sh
 if ! command -v valgrind >/dev/null 2>&1; then
     apt_install valgrind
 fi
-cargo build --release --bin bench_mpc --example rti_profile
+cargo build --release --bin bench_mpc --example rti_profile --example startup
 target_dir=${CARGO_TARGET_DIR:-target}
 profile="$target_dir/release/examples/rti_profile"
 cpu=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')
@@ -32,15 +33,15 @@ total() { # function-pattern start seconds qp variant -> instructions
         /PROGRAM TOTALS/ { gsub(",", "", $1); print $1; exit }'
     rm -f "$file"
 }
-count() { # start seconds qp variant -> "step linearise qp"
+count() { # start seconds qp variant [robot energy tau_max] -> "step linearise qp"
     echo "$(total '*Controller<S,_,_>::step' "$@") \
 $(total '*Controller<S,_,_>>::linearise' "$@") \
 $(total '*as eigenmpc::qp::QpSolver>::solve' "$@")"
 }
-per_sample() { # start qp variant
+per_sample() { # start qp variant [robot energy tau_max]
     local a b
-    a=($(count "$1" 10 "$2" "$3"))
-    b=($(count "$1" 20 "$2" "$3"))
+    a=($(count "$1" 10 "${@:2}"))
+    b=($(count "$1" 20 "${@:2}"))
     # 400 samples between 10 s and 20 s at 25 ms.
     awk -v s1="${a[0]}" -v s2="${b[0]}" -v l1="${a[1]}" -v l2="${b[1]}" \
         -v q1="${a[2]}" -v q2="${b[2]}" 'BEGIN {
@@ -65,7 +66,21 @@ per_sample() { # start qp variant
     done
     echo "| orbit | curved | clarabel | $(per_sample orbit clarabel curved) |"
     echo
+    echo "The robots of the table below (curved, riccati, from every joint at 0.05 rad at rest, the controller \`eigenmpc simulate --model FILE\` builds), thousands of instructions per sample from 10 s to 20 s (on the orbit for all of them by then):"
+    echo
+    echo "| robot | E_ref J | step (k instr.) | linearisation (k instr.) | QP solve (k instr.) |"
+    echo "|---|---|---|---|---|"
+    while read -r robot energy tau_max; do
+        echo "| $(basename "$robot") | $energy | $(per_sample rest riccati curved "$robot" "$energy" "$tau_max") |"
+    done < <("$target_dir/release/bench_mpc" --list-robots)
+    echo
     "$target_dir/release/bench_mpc"
+    echo
+    echo "## The first sample"
+    echo
+    echo "The first sample starts from a zero-torque guess. \`Startup::Iterations(n)\` (the default: 10) takes n full Gauss-Newton iterations in it, one linearisation and one QP each: bounded work. \`Startup::Converge\` is the paper's converged SQP with its L1-merit line search (at most 30 iterations): on the laboratory robots the Coulomb friction keeps it from converging, so it always runs to that limit, with many step halvings. Curved, riccati, N = 80, 30 s from every joint at 0.05 rad at rest, the controller \`eigenmpc simulate --model FILE\` builds (\`cargo run --release --example startup\`); times on the machine above:"
+    echo
+    "$target_dir/release/examples/startup"
 } > "$out.tmp"
 mv "$out.tmp" "$out"
 echo "wrote $out"

@@ -7,7 +7,7 @@ use eigenmpc::modes::linear_modes;
 use eigenmpc::mpc::Guide;
 use eigenmpc::mpc::closed_loop::mode_and_chart;
 use eigenmpc::mpc::cost::{CostParams, Reference, residuals, stage_model};
-use eigenmpc::mpc::{ControlStatus, Controller, MpcConfig, MpcError, Variant};
+use eigenmpc::mpc::{ControlStatus, Controller, MpcConfig, MpcError, Startup, Variant};
 use eigenmpc::qp::clarabel::{ClarabelQpSolver, accurate_settings};
 use eigenmpc::qp::{OcpQp, QpSolution, QpSolver, QpStatus, kkt_residuals};
 use nalgebra::{DVector, SVector};
@@ -221,7 +221,7 @@ fn clarabel_qp_solutions_satisfy_kkt() {
         for (reference, variant) in [(straight(), Variant::Straight), (curved(), Variant::Curved)] {
             let mut config = MpcConfig::paper(variant);
             config.tau_max = tau_max;
-            config.converge_first_sample = false;
+            config.startup = Startup::Iterations(1);
             for accurate in [false, true] {
                 let mut ctrl = controller(reference.clone(), config, accurate);
                 let mut zz = z;
@@ -267,6 +267,7 @@ fn rti_iterations_converge_to_the_sqp_solution_on_the_first_sample() {
         config.horizon = 40;
         config.sqp.tolerance = 1e-10;
         config.sqp.max_iterations = 60;
+        config.startup = Startup::Converge;
         let mut sqp = controller(reference.clone(), config, true);
         let reference_out = sqp.step(&z);
         assert_eq!(reference_out.status, ControlStatus::Solved, "{variant}");
@@ -277,14 +278,13 @@ fn rti_iterations_converge_to_the_sqp_solution_on_the_first_sample() {
         assert!(kkt_residuals(qp, sol).max() < 1e-8);
 
         let mut rti_config = config;
-        rti_config.converge_first_sample = false;
-        rti_config.iterations_per_sample = 1;
+        rti_config.startup = Startup::Iterations(1);
         let mut rti = controller(reference, rti_config, true);
         let first = rti.step(&z);
         // One RTI from the zero-torque guess is already a useful step...
         assert!(first.tau.amax() > 0.0);
         // ...and repeated RTIs at the same state converge to the SQP solution.
-        rti_config.iterations_per_sample = 30;
+        rti_config.startup = Startup::Iterations(30);
         let mut rti = controller(rti.reference().clone(), rti_config, true);
         let out = rti.step(&z);
         let diff = (out.tau - reference_out.tau).amax();

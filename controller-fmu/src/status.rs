@@ -3,8 +3,10 @@
 
 /// The QP(s) were solved; the torque is optimal.
 pub const STATUS_SOLVED: i32 = 0;
-/// The converged SQP of the first sample hit its iteration limit; the
-/// torque is from the last iterate.
+/// A converged start-up (`Startup::Converge` of the Rust API) hit its
+/// iteration limit; the torque is from the last iterate. The C API and
+/// the FMU start with bounded Gauss-Newton iterations and do not report
+/// it.
 pub const STATUS_NOT_CONVERGED: i32 = 1;
 /// A QP failed; the torque is the fallback (the shifted previous plan's
 /// control, clipped; zero without a plan).

@@ -6,14 +6,25 @@
 //! online adaptation's share (identification every sample, new models and
 //! families swapped in while a worker thread computes them).
 //!
+//! The robots users have come first: the paper's pendulum beside the
+//! laboratory pendulums of `robots/` (friction, geared motors, rigid links)
+//! and two 3-link chains, each with the controller `eigenmpc simulate
+//! --model FILE` builds.
+//!
 //! `cargo run --release --bin bench_mpc [-- --duration 30]`. Prints
-//! markdown tables. The first sample (converged SQP from a cold start) is
-//! reported separately and excluded from the per-sample statistics.
+//! markdown tables (`--list-robots`: the robots, one `FILE ENERGY TAU_MAX`
+//! line each, for `scripts/bench.sh`'s instruction counts). The first sample (the start-up from a zero-torque
+//! guess) is reported separately and excluded from the per-sample
+//! statistics.
 
 use eigenmpc::adapt::{AdaptOptions, Adaptation};
 use eigenmpc::mechanics::{DoublePendulum, PlanarChain, PlanarChainParams};
+use eigenmpc::model_file::RobotFile;
 use eigenmpc::modes::{ChartFamily, FamilyOptions};
-use eigenmpc::mpc::closed_loop::{Sample, mode_and_chart, quantile, reference_for, run};
+use eigenmpc::mpc::closed_loop::{
+    START_ANGLE, Sample, mode_and_chart, quantile, reference_for, robot_controller, run, run_with,
+    summarise,
+};
 use eigenmpc::mpc::{Controller, MpcConfig, QpBackend, Variant};
 use eigenmpc::robustness::{Imperfections, run_imperfect};
 use nalgebra::SVector;
@@ -95,6 +106,13 @@ fn cpu() -> String {
 fn main() {
     let mut duration = 30.0;
     let args: Vec<String> = std::env::args().collect();
+    if args.iter().any(|a| a == "--list-robots") {
+        // For scripts/bench.sh's instruction counts: the same robots.
+        for case in ROBOTS {
+            println!("{} {} {}", case.file, case.energy, case.tau_max);
+        }
+        return;
+    }
     if let Some(i) = args.iter().position(|a| a == "--duration") {
         duration = args
             .get(i + 1)
@@ -105,8 +123,9 @@ fn main() {
                 std::process::exit(2)
             });
     }
+    robots_table(duration);
     println!(
-        "## EigenMPC control step, N = 80, dt = 25 ms, {duration} s closed loop, both QP backends\n"
+        "\n## EigenMPC control step, N = 80, dt = 25 ms, {duration} s closed loop, both QP backends\n"
     );
     println!(
         "Measured on {} ({} threads). The ratio column divides the sample median by clarabel's in the same run (same process, same machine state): it moves less between machines than the times. QP iterations are Riccati recursions per sample: the guesses of riccati's active-set start where it solves the QP, the interior point's iterations otherwise (clarabel: its interior-point iterations).\n",
@@ -170,7 +189,7 @@ fn main() {
                 median_total(trace) / clarabel
             );
             println!(
-                "| {name} | {backend} | first sample (converged SQP, cold start) | {:.3} | | | | {failures} failed samples | |",
+                "| {name} | {backend} | first sample (start-up, cold start) | {:.3} | | | | {failures} failed samples | |",
                 trace[0].solve_time * 1e3
             );
         }
@@ -204,6 +223,130 @@ fn main() {
     }
     three_link_table(duration.max(40.0));
     adaptation_table(duration.max(60.0));
+}
+
+/// A robot of the benchmark: its file (under the workspace root), the
+/// reference energy and the torque bound.
+struct RobotCase {
+    file: &'static str,
+    energy: f64,
+    tau_max: f64,
+    /// Closed-loop length (s): at least the benchmark's, long enough to
+    /// reach the band.
+    duration: f64,
+}
+
+/// The robots of [`robots_table`]: the paper's pendulum and 3-link chain
+/// (point masses, no friction), the laboratory pendulums at the README's
+/// set-up, and a 3-link rigid chain with friction.
+const ROBOTS: &[RobotCase] = &[
+    RobotCase {
+        file: "robots/paper-double-pendulum.yml",
+        energy: 14.0,
+        tau_max: 1.0,
+        duration: 30.0,
+    },
+    RobotCase {
+        file: "robots/lab-double-pendulum-A0.yml",
+        energy: 2.0,
+        tau_max: 0.5,
+        duration: 30.0,
+    },
+    RobotCase {
+        file: "robots/lab-double-pendulum-B0.yml",
+        energy: 2.0,
+        tau_max: 0.5,
+        duration: 30.0,
+    },
+    RobotCase {
+        file: "robots/three-link-point-masses.yml",
+        energy: 14.0,
+        tau_max: 1.0,
+        duration: 60.0,
+    },
+    RobotCase {
+        file: "robots/examples/three-link-rigid.yml",
+        energy: 1.0,
+        tau_max: 1.0,
+        duration: 30.0,
+    },
+];
+
+/// Per-sample cost on each robot of [`ROBOTS`]: curved, riccati, N = 80,
+/// from every joint at 0.05 rad at rest, the controller `eigenmpc simulate
+/// --model FILE --energy E --tau-max T` builds.
+fn robots_table(duration: f64) {
+    println!(
+        "## The control step on each robot (curved, riccati, N = 80, dt = 25 ms, from rest, at least {duration} s; on {})\n",
+        cpu()
+    );
+    println!(
+        "Times in ms; the first sample (the start-up from a zero-torque guess) apart, the others' statistics without it. RK4 substeps: the most an interval takes (what the friction needs with a joint at rest) and the mean over the intervals of all samples (only intervals in which a joint may stop take the most). Preparation is the shift and the linearisation (RK4 substeps with sensitivities, cost Jacobians, the QP's stages), feedback the QP solve. QP recursions: the Riccati recursions of the active-set start where it solves the QP, else the interior point's iterations; \"active-set start\": the share of samples it solved.\n"
+    );
+    println!(
+        "| robot | E_ref J | s | RK4 substeps most / mean | band s | first sample | median | p95 | p99 | max | preparation median | feedback median | QP recursions median / max | active-set start |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    for case in ROBOTS {
+        let file = RobotFile::load(root.join(case.file)).expect("robot file");
+        let row = match file.links() {
+            2 => robot_row::<2, 4>(&file, case, duration.max(case.duration)),
+            3 => robot_row::<3, 6>(&file, case, duration.max(case.duration)),
+            n => panic!("{}: {n} links: add its row", case.file),
+        };
+        println!("{row}");
+    }
+}
+
+/// One row of [`robots_table`].
+fn robot_row<const N: usize, const NX: usize>(
+    file: &RobotFile,
+    case: &RobotCase,
+    duration: f64,
+) -> String {
+    let robot = file.chain::<N>().expect("chain");
+    let (mut ctrl, _) =
+        robot_controller::<N, NX>(&robot, Variant::Curved, case.energy, case.tau_max)
+            .expect("controller");
+    let substeps = ctrl.config().substeps;
+    let z0 = SVector::<f64, NX>::from_fn(|i, _| if i < N { START_ANGLE } else { 0.0 });
+    let mut by_start = Vec::new();
+    let mut substeps_taken = 0;
+    let trace = run_with(&mut ctrl, &robot, &z0, duration, |i, c, _| {
+        if i > 0 {
+            by_start.push(c.last_qp_solved_by_start() == Some(true));
+            substeps_taken += c.last_linearisation_substeps();
+        }
+    })
+    .expect("closed loop");
+    let band = summarise(&trace, case.energy, None, 5.0)
+        .time_to_5_percent
+        .map_or("never".to_string(), |t| format!("{t:.3}"));
+    let rest = &trace[1..];
+    let total = stats(rest.iter().map(|s| s.solve_time).collect());
+    let prep = stats(rest.iter().map(|s| s.preparation_time).collect());
+    let feedback = stats(
+        rest.iter()
+            .map(|s| s.solve_time - s.preparation_time)
+            .collect(),
+    );
+    let iters = stats(rest.iter().map(|s| s.qp_iterations as f64).collect());
+    let share = by_start.iter().filter(|&&b| b).count() as f64 / by_start.len().max(1) as f64;
+    let name = case.file.rsplit('/').next().unwrap_or(case.file);
+    let horizon = ctrl.config().horizon;
+    let mean_substeps = substeps_taken as f64 / (by_start.len().max(1) * horizon) as f64;
+    format!(
+        "| {name} | {} | {duration} | {substeps} / {mean_substeps:.2} | {band} | {:.3} | {} | {:.3} | {:.3} | {:.0} / {:.0} | {:.0} % |",
+        case.energy,
+        trace[0].solve_time * 1e3,
+        ms(total),
+        prep[0] * 1e3,
+        feedback[0] * 1e3,
+        iters[0],
+        iters[3],
+        share * 100.0
+    )
 }
 
 /// The 3-link point-mass chain (1 kg, 1 m), curved on its in-phase family

@@ -455,3 +455,35 @@ where
     let chart = Chart::fit(&mode.path, &eigenvector, &system.equilibrium(), degree)?;
     Ok((mode, chart))
 }
+
+/// The controller `eigenmpc simulate --model FILE` builds for a robot: the
+/// paper's set-up (in-phase family, `E_ref = energy`, `|tau| <= tau_max`)
+/// with the robot's prediction model, the RK4 substeps and Coulomb slope its
+/// friction needs ([`super::prediction_substeps`]); and the model's
+/// eigenmode at `energy` (the distance metric's path).
+pub fn robot_controller<const N: usize, const NX: usize>(
+    robot: &crate::mechanics::PlanarChain<N>,
+    variant: super::Variant,
+    energy: f64,
+    tau_max: f64,
+) -> Result<
+    (
+        Controller<crate::mechanics::PlanarChain<N>, N, NX>,
+        crate::modes::Eigenmode<N>,
+    ),
+    String,
+> {
+    let mut config = super::MpcConfig::paper(variant);
+    config.substeps = super::prediction_substeps(robot, config.dt);
+    config.tau_max = tau_max;
+    config.cost.e_ref = energy;
+    let sharpness = super::prediction_coulomb_sharpness(robot, config.dt / config.substeps as f64);
+    let model = robot
+        .with_coulomb_sharpness(sharpness)
+        .map_err(|e| e.to_string())?;
+    let (mode, chart) =
+        mode_and_chart::<_, N, NX>(&model, 0, energy, 9).map_err(|e| e.to_string())?;
+    let reference = super::Reference::with_chart(variant, chart);
+    let controller = Controller::new(model, config, reference).map_err(|e| e.to_string())?;
+    Ok((controller, mode))
+}

@@ -11,6 +11,38 @@ use thiserror::Error;
 /// API share it; memory and time grow linearly in `N`).
 pub const MAX_HORIZON: usize = 1000;
 
+/// Most first-sample Gauss-Newton iterations ([`Startup::Iterations`]).
+pub const MAX_STARTUP_ITERATIONS: usize = 100;
+
+/// How the first sample solves, from the zero-torque guess.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Startup {
+    /// This many full Gauss-Newton iterations (RTI steps, no line search)
+    /// in the first sample: its work is bounded, one linearisation and one
+    /// QP each, about ten RTI samples for the default
+    /// [`Startup::DEFAULT_ITERATIONS`]. The samples after it continue as
+    /// RTI.
+    Iterations(usize),
+    /// The SQP with an L1-merit line search to convergence
+    /// ([`MpcConfig::sqp`]; the paper's converged first sample): its time is
+    /// not bounded, 0.1-0.8 s on the laboratory robots, whose Coulomb
+    /// friction keeps it from converging within its iteration limit.
+    Converge,
+}
+
+impl Startup {
+    /// The default first sample's Gauss-Newton iterations: on the paper's
+    /// pendulum and the laboratory robots the band time of the converged
+    /// start or better (docs/speed.md "First sample").
+    pub const DEFAULT_ITERATIONS: usize = 10;
+}
+
+impl Default for Startup {
+    fn default() -> Self {
+        Startup::Iterations(Self::DEFAULT_ITERATIONS)
+    }
+}
+
 /// Settings of the converged SQP mode.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SqpOptions {
@@ -36,8 +68,13 @@ pub struct MpcConfig {
     pub horizon: usize,
     /// Shooting interval and sample period `dt` (s).
     pub dt: f64,
-    /// RK4 substeps per shooting interval.
+    /// RK4 substeps per shooting interval (the most, with
+    /// `substeps_where_stiff`).
     pub substeps: usize,
+    /// Take all `substeps` only in intervals where a joint may come to rest
+    /// (the Coulomb friction's slope is steep there), fewer elsewhere
+    /// (default true; false: all of them in every interval).
+    pub substeps_where_stiff: bool,
     /// Torque bound `|tau_i| <= tau_max` (N m).
     pub tau_max: f64,
     /// Cost parameters (tunable between samples).
@@ -54,8 +91,8 @@ pub struct MpcConfig {
     pub soft_l2: f64,
     /// SQP iterations per sample (1 = plain RTI).
     pub iterations_per_sample: usize,
-    /// Solve the first sample to convergence (else start from a zero-torque guess).
-    pub converge_first_sample: bool,
+    /// How the first sample solves (from a zero-torque guess).
+    pub startup: Startup,
     /// Converged-SQP settings.
     pub sqp: SqpOptions,
     /// QP solver built by [`Controller::new`](super::Controller::new) (default riccati, see docs/results.md).
@@ -90,6 +127,7 @@ impl MpcConfig {
             horizon: 80,
             dt: 0.025,
             substeps: 1,
+            substeps_where_stiff: true,
             tau_max: 1.0,
             cost: CostParams {
                 e_ref: 14.0,
@@ -105,7 +143,7 @@ impl MpcConfig {
             soft_l1: 1e3,
             soft_l2: 1e3,
             iterations_per_sample: 1,
-            converge_first_sample: true,
+            startup: Startup::default(),
             sqp: SqpOptions::default(),
             qp: QpBackend::default(),
             estimator: None,
@@ -184,6 +222,15 @@ impl MpcConfig {
             if v > self.horizon as f64 * self.dt {
                 return bad(name, v, "must be at most the horizon's length (horizon dt)");
             }
+        }
+        if let Startup::Iterations(n) = self.startup
+            && !(1..=MAX_STARTUP_ITERATIONS).contains(&n)
+        {
+            return bad(
+                "startup iterations",
+                n as f64,
+                "must be in 1..=100 (Startup::Converge for a converged first sample)",
+            );
         }
         if self.sqp.max_iterations == 0 {
             return bad("sqp.max_iterations", 0.0, "must be >= 1");

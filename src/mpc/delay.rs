@@ -168,12 +168,13 @@ where
         let lagged = self.config.actuator_time_constant > 0.0;
         if d.fract() == 0.0 && !lagged {
             let (u, _) = self.history.entry(d as usize + 1);
-            let (next, a, _) = self.interval_sensitivity(from, &u);
+            let (next, a, _) =
+                self.interval_sensitivity(from, &u, self.interval_substeps(from, &u));
             return (next, a);
         }
         let next = self.integrate_history(from, d + 1.0, d, true);
         let (u, _) = self.history.entry((d + 0.5).ceil() as usize);
-        let (_, a, _) = self.interval_sensitivity(from, &u);
+        let (_, a, _) = self.interval_sensitivity(from, &u, self.interval_substeps(from, &u));
         (next, a)
     }
 

@@ -4,37 +4,83 @@
 use super::Controller;
 use super::cost::stage_model;
 use crate::integrate::rk4_step_sensitivity;
-use crate::mechanics::{MechanicalSystem, Vector};
+use crate::mechanics::{MechanicalSystem, Vector, unpack_state};
 use nalgebra::{SMatrix, SVector};
+
+/// How far a joint's speed may move within an interval, in units of its
+/// acceleration at the interval's start times `dt` (the acceleration
+/// changes within the interval: a margin). Measured on the laboratory
+/// robots (docs/speed.md): 1.0-2.0 give the same closed loops, 1.0-1.25
+/// the fewest substeps.
+pub const SPEED_REACH: f64 = 1.5;
 
 impl<S, const N: usize, const NX: usize> Controller<S, N, NX>
 where
     S: MechanicalSystem<N>,
 {
+    /// RK4 substeps of the interval from `z` under `u`. `config.substeps`
+    /// is what the model's Coulomb friction needs with a joint at rest,
+    /// where its slope `cf k` is steepest; with
+    /// `config.substeps_where_stiff` only an interval in which a joint may
+    /// come to rest takes them all. Elsewhere every joint's slope is
+    /// flatter, `cf k / (1 + (k v)^2)` at its slowest speed `v` in reach
+    /// (its speed plus or minus [`SPEED_REACH`] times its acceleration
+    /// times `dt`), and the substeps shrink in proportion: the same
+    /// stability margin per substep, at least one.
+    pub fn interval_substeps(&self, z: &SVector<f64, NX>, u: &Vector<N>) -> usize {
+        let most = self.config.substeps;
+        if most == 1 || !self.config.substeps_where_stiff {
+            return most;
+        }
+        let steepest = self.system.friction_slope(&Vector::zeros()).max();
+        if steepest.is_nan() || steepest <= 0.0 {
+            return most;
+        }
+        let (q, qd) = unpack_state::<N, NX>(z);
+        let qdd = self.system.forward_dynamics(&q, &qd, u);
+        let reach = SPEED_REACH * self.config.dt;
+        let slowest = Vector::<N>::from_fn(|j, _| {
+            let (lo, hi) = (qd[j] - reach * qdd[j].abs(), qd[j] + reach * qdd[j].abs());
+            if lo <= 0.0 && hi >= 0.0 {
+                0.0
+            } else {
+                lo.abs().min(hi.abs())
+            }
+        });
+        let slope = self.system.friction_slope(&slowest).max();
+        if !slope.is_finite() {
+            return most;
+        }
+        ((most as f64 * slope / steepest).ceil() as usize).clamp(1, most)
+    }
+
     pub(super) fn simulate_interval(
         &self,
         z: &SVector<f64, NX>,
         u: &Vector<N>,
     ) -> SVector<f64, NX> {
-        let h = self.config.dt / self.config.substeps as f64;
+        let substeps = self.interval_substeps(z, u);
+        let h = self.config.dt / substeps as f64;
         let mut x = *z;
-        for _ in 0..self.config.substeps {
+        for _ in 0..substeps {
             x = crate::integrate::rk4_step::<S, N, NX>(&self.system, &x, u, h);
         }
         x
     }
 
-    /// Integration with sensitivities over one shooting interval.
+    /// Integration with sensitivities over one shooting interval, in
+    /// `substeps` RK4 steps.
     pub(super) fn interval_sensitivity(
         &self,
         z: &SVector<f64, NX>,
         u: &Vector<N>,
+        substeps: usize,
     ) -> (SVector<f64, NX>, SMatrix<f64, NX, NX>, SMatrix<f64, NX, N>) {
-        let h = self.config.dt / self.config.substeps as f64;
+        let h = self.config.dt / substeps as f64;
         let mut x = *z;
         let mut a = SMatrix::<f64, NX, NX>::identity();
         let mut b = SMatrix::<f64, NX, N>::zeros();
-        for _ in 0..self.config.substeps {
+        for _ in 0..substeps {
             let s = rk4_step_sensitivity::<S, N, NX>(&self.system, &x, u, h);
             x = s.z_next;
             b = s.d_z * b + s.d_tau;
@@ -49,8 +95,11 @@ where
         let cost = self.config.cost;
         let dt = self.config.dt;
         let q_eq = self.system.equilibrium();
+        let mut substeps_taken = 0;
         for k in 0..nh {
-            let (x_next, a, b) = self.interval_sensitivity(&self.xs[k], &self.us[k]);
+            let substeps = self.interval_substeps(&self.xs[k], &self.us[k]);
+            substeps_taken += substeps;
+            let (x_next, a, b) = self.interval_sensitivity(&self.xs[k], &self.us[k], substeps);
             let m = stage_model::<S, N, NX>(
                 &self.system,
                 &self.reference,
@@ -72,6 +121,7 @@ where
                 self.qp.u_upper[k][i] = self.config.tau_max - self.us[k][i];
             }
         }
+        self.substeps_taken = substeps_taken;
         let scale = dt * self.config.terminal_scale;
         if scale > 0.0 {
             let m = stage_model::<S, N, NX>(

@@ -12,10 +12,12 @@
 //!   RK4 steps, `src/mpc/delay.rs`) as `dx_0 = z - x_0`, solve the QP,
 //!   take the full step and return `tau_0`.
 //!
-//! Optionally several iterations per sample, and a converged SQP with an
-//! L1-merit backtracking line search ([`Controller::solve_to_convergence`]),
-//! used by default for the very first sample. Everything is sized at
-//! creation; the per-sample path does not allocate.
+//! Optionally several iterations per sample. The first sample starts from a
+//! zero-torque guess and takes ten full Gauss-Newton iterations
+//! ([`Startup`]): bounded work, where the converged SQP with an L1-merit
+//! backtracking line search ([`Controller::solve_to_convergence`],
+//! `Startup::Converge`) took up to 0.8 s on robots with Coulomb friction.
+//! Everything is sized at creation; the per-sample path does not allocate.
 
 #[cfg(feature = "tooling")]
 pub mod closed_loop;
@@ -24,12 +26,16 @@ pub mod cost;
 mod delay;
 mod estimator;
 mod linearise;
+pub use linearise::SPEED_REACH;
 pub mod prediction;
 mod saved;
 mod sqp;
 mod status;
 
-pub use config::{MAX_COMPENSATED_TIME, MAX_HORIZON, MpcConfig, MpcError, SqpOptions};
+pub use config::{
+    MAX_COMPENSATED_TIME, MAX_HORIZON, MAX_STARTUP_ITERATIONS, MpcConfig, MpcError, SqpOptions,
+    Startup,
+};
 pub use cost::{
     CostParams, CostVariant, Guide, PAPER_ENERGY_SCALE, Reference, ReferenceError, VARIANTS,
     Variant, VariantInfo, Weights,
@@ -68,6 +74,8 @@ pub struct Controller<S, const N: usize, const NX: usize> {
     shift_pending: bool,
     /// L1 merit penalty parameter (grows monotonically until a reset).
     merit_penalty: f64,
+    /// RK4 substeps of the last linearisation, over all intervals.
+    substeps_taken: usize,
     /// Preparation time already spent for the coming sample.
     pending_preparation_time: f64,
     /// The last sample's QP solution may seed the next one (warm start).
@@ -137,6 +145,7 @@ where
             prepared: false,
             shift_pending: false,
             merit_penalty: 1.0,
+            substeps_taken: 0,
             pending_preparation_time: 0.0,
             warm_start_usable: false,
             consecutive_qp_failures: 0,
@@ -282,6 +291,19 @@ where
     /// The last QP and its solution (diagnostics, tests).
     pub fn last_qp(&self) -> (&OcpQp, &QpSolution) {
         (&self.qp, &self.solution)
+    }
+
+    /// RK4 substeps the last linearisation took over all `N` intervals
+    /// (`N` times `substeps` without `substeps_where_stiff`; benchmarks).
+    pub fn last_linearisation_substeps(&self) -> usize {
+        self.substeps_taken
+    }
+
+    /// Whether the QP solver's start (riccati: the active-set start)
+    /// solved the last QP without its main method; `None` for a solver
+    /// without one (benchmarks).
+    pub fn last_qp_solved_by_start(&self) -> Option<bool> {
+        self.solver.last_solved_by_start()
     }
 
     /// Sets all tunable cost parameters at once (no rebuild, no allocation).
@@ -447,10 +469,9 @@ where
             self.fallback(ControlStatus::InvalidState)
         } else if !self.initialised {
             self.initialise(z);
-            if self.config.converge_first_sample {
-                self.solve_to_convergence(z)
-            } else {
-                self.iterate(z, self.config.iterations_per_sample)
+            match self.config.startup {
+                Startup::Iterations(n) => self.iterate(z, n),
+                Startup::Converge => self.solve_to_convergence(z),
             }
         } else {
             self.iterate(z, self.config.iterations_per_sample)

@@ -7,7 +7,10 @@
 //! is unstable (RK4's limit on the negative real axis is 2.79).
 //!
 //! The prediction model keeps the plant's law and takes RK4 substeps
-//! ([`prediction_substeps`]) until `h lambda <= PREDICTION_FRICTION_STEP_LIMIT`.
+//! ([`prediction_substeps`]) until `h lambda <= PREDICTION_FRICTION_STEP_LIMIT`,
+//! with a joint at rest; an interval in which every joint stays fast, where
+//! the law is flat, takes fewer
+//! ([`super::MpcConfig::substeps_where_stiff`]).
 //! Measured on the A0 robot (`robots/`): lowering the slope instead (to
 //! `k` ~ 5 for one 25 ms step) makes the model underestimate friction at
 //! moderate speeds (`atan(5) = 0.87 pi/2`), the energy settles 1-2 % low

@@ -8,7 +8,8 @@ use crate::qp::QpStatus;
 pub enum ControlStatus {
     /// The QP(s) were solved; `tau` is the optimal first control.
     Solved,
-    /// The converged-SQP mode hit its iteration limit; `tau` is from the last iterate.
+    /// The converged start-up ([`super::Startup::Converge`]) hit its
+    /// iteration limit; `tau` is from the last iterate.
     NotConverged,
     /// A QP failed; `tau` is the shifted previous plan's control, clipped.
     QpFailed(QpStatus),
@@ -51,7 +52,9 @@ impl std::fmt::Display for ControlStatus {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             ControlStatus::Solved => f.write_str("solved"),
-            ControlStatus::NotConverged => f.write_str("SQP not converged (iteration limit)"),
+            ControlStatus::NotConverged => {
+                f.write_str("start-up SQP not converged (iteration limit)")
+            }
             ControlStatus::QpFailed(s) => {
                 write!(f, "QP failed ({s:?}): holding the shifted previous plan")
             }

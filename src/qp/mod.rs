@@ -271,6 +271,13 @@ pub trait QpSolver {
     /// Solves `qp` into `solution` (overwritten in place); returns the status
     /// that is also stored in `solution.status`. Never panics on bad data.
     fn solve(&mut self, qp: &OcpQp, solution: &mut QpSolution) -> QpStatus;
+    /// Whether the last solve was finished by a warm or active-set start
+    /// without the solver's main method (riccati: its active-set start,
+    /// no interior point); `None` for a solver without one. Diagnostics
+    /// and benchmarks.
+    fn last_solved_by_start(&self) -> Option<bool> {
+        None
+    }
     /// Tells the solver that the next QP is the last one shifted by one
     /// stage (RTI), so it may start from the shifted previous solution;
     /// `previous_usable` is false when the last solve failed. Default: ignored.

@@ -34,8 +34,8 @@ energy weight of the variant: 25 curved, 5 straight. Below <code>E_scale</code> 
 <code>sqrt(E_scale / E_ref)</code>, so that a low <code>E_ref</code> is reached about as fast \
 as 14 J; from <code>E_scale</code> up, and with <code>E_scale</code> = 0, it is the \
 paper's <code>E_ref - E</code>.</p>\
-<p><b>solver_status.</b> 0 solved; 1 first-sample SQP not converged (torque from the last \
-iterate); 2 QP failed: the torque is the fallback (the previous plan's next control, clipped) \
+<p><b>solver_status.</b> 0 solved (the first sample too: ten Gauss-Newton iterations from a \
+zero-torque guess, bounded work); 1 not converged (not reported by this FMU); 2 QP failed: the torque is the fallback (the previous plan's next control, clipped) \
 and a warning is logged. Code 3 (invalid state) belongs to the C API: this FMU refuses NaN/Inf \
 inputs with fmi2Error before any solve.</p>\
 <p><b>Delay and lag.</b> <code>measurement_delay</code> (s) declares the age of the measured \

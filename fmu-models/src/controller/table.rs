@@ -94,16 +94,17 @@ pub fn table<const N: usize>() -> Table<Settings<N>> {
         Rw::<N>::integer("solver_status", Shape::Scalar)
             .output()
             .describe(
-                "Status of the last solve: 0 solved; 1 cold-start SQP not converged (the \
-                 first sample, or the first after a failed QP reset the plan; torque from \
-                 the last iterate); 2 QP failed (torque = fallback: previous plan's next \
+                "Status of the last solve: 0 solved (also the first sample, and the first \
+                 after a failed QP reset the plan: ten Gauss-Newton iterations from a \
+                 zero-torque guess, bounded work); 1 not converged (reported only by the \
+                 converged start-up of the Rust API, which the FMU does not use); 2 QP failed (torque = fallback: previous plan's next \
                  control, clipped; logged as a warning the first time and every 100th). 3 \
                  (invalid state) only occurs through the C API: the FMU refuses NaN/Inf \
                  inputs with fmi2Error",
             )
             .summary(
-                "0 solved; 1 cold-start SQP not converged (first sample, or first after a \
-                 failed QP reset the plan); 2 QP failed (fallback torque = previous plan's \
+                "0 solved (the first sample too: ten Gauss-Newton iterations from a \
+                 zero-torque guess); 1 not converged (not reported by the FMU); 2 QP failed (fallback torque = previous plan's \
                  next control, clipped; warning logged the first time and every 100th); 3 \
                  invalid state occurs only through the C API: the FMU refuses NaN/Inf inputs \
                  with fmi2Error",

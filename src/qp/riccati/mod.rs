@@ -243,6 +243,10 @@ impl QpSolver for RiccatiSolver {
         "riccati"
     }
 
+    fn last_solved_by_start(&self) -> Option<bool> {
+        Some(self.info.active_set_start)
+    }
+
     fn save_warm_start(&self) -> Vec<f64> {
         let mut out = vec![
             f64::from(u8::from(self.warm_next)),

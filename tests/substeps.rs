@@ -1,0 +1,111 @@
+//! RK4 substeps only where the Coulomb friction is stiff
+//! (`MpcConfig::substeps_where_stiff`): an interval in which a joint may
+//! come to rest takes every substep the model's friction needs, a fast one
+//! fewer, and the prediction and the closed loop stay what they were with
+//! every substep everywhere (docs/speed.md).
+
+use eigenmpc::integrate::{Tolerances, rk4_step, simulate_accurate};
+use eigenmpc::mechanics::{PlanarChain, Vector};
+use eigenmpc::model_file::RobotFile;
+use eigenmpc::mpc::Variant;
+use eigenmpc::mpc::closed_loop::{START_ANGLE, energy_tail, robot_controller, run, summarise};
+use nalgebra::SVector;
+
+fn lab_robot(name: &str) -> PlanarChain<2> {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("robots")
+        .join(name);
+    RobotFile::load(path).unwrap().chain::<2>().unwrap()
+}
+
+/// `n` RK4 steps over `dt` against the accurate integration of the same model.
+fn prediction_error(model: &PlanarChain<2>, z: &SVector<f64, 4>, u: &Vector<2>, n: usize) -> f64 {
+    let dt = 0.025;
+    let mut x = *z;
+    for _ in 0..n {
+        x = rk4_step::<_, 2, 4>(model, &x, u, dt / n as f64);
+    }
+    let tol = Tolerances {
+        rtol: 1e-12,
+        atol: 1e-12,
+    };
+    let exact = simulate_accurate::<_, 2, 4>(model, z, u, dt, tol).unwrap();
+    (x - exact).amax()
+}
+
+#[test]
+fn an_interval_where_a_joint_may_stop_takes_every_substep_and_a_fast_one_fewer() {
+    for name in ["lab-double-pendulum-A0.yml", "lab-double-pendulum-B0.yml"] {
+        let robot = lab_robot(name);
+        let (ctrl, _) = robot_controller::<2, 4>(&robot, Variant::Curved, 2.0, 0.5).unwrap();
+        let most = ctrl.config().substeps;
+        assert!(most >= 9, "{name}: {most} substeps");
+        let model = ctrl.system();
+        let u = Vector::<2>::new(0.1, -0.05);
+        // Near rest both joints may stop: every substep, and they are needed
+        // (one step of 25 ms is unstable on the friction's slope; the
+        // substeps predict its decay to 1e-3 rad/s, they do not resolve it).
+        let rest = SVector::<f64, 4>::new(0.3, -0.2, 0.01, 0.0);
+        assert_eq!(ctrl.interval_substeps(&rest, &u), most, "{name}");
+        let resolved = prediction_error(model, &rest, &u, most);
+        let one_step = prediction_error(model, &rest, &u, 1);
+        assert!(
+            resolved < 1e-3 && one_step > 100.0 * resolved,
+            "{name}: {resolved:e} {one_step:e}"
+        );
+        // Both joints fast, far from stopping within 25 ms: one substep,
+        // RK4's accuracy on a smooth interval (the paper's pendulum takes
+        // one substep of 25 ms everywhere).
+        let fast = SVector::<f64, 4>::new(0.1, -0.1, 3.0, -3.0);
+        let n = ctrl.interval_substeps(&fast, &u);
+        assert_eq!(n, 1, "{name}");
+        let err = prediction_error(model, &fast, &u, n);
+        assert!(err < 1e-4, "{name}: {err:e}");
+        // One joint slow, the other fast: the slow one decides (its own
+        // slope, a little flatter than the steepest joint's at rest).
+        let mixed = SVector::<f64, 4>::new(0.1, -0.1, 3.0, 0.005);
+        let n = ctrl.interval_substeps(&mixed, &u);
+        assert!(2 * n > most, "{name}: {n} of {most}");
+        let err = prediction_error(model, &mixed, &u, n);
+        assert!(err < 1e-4, "{name}: {err:e}");
+    }
+}
+
+#[test]
+fn closed_loops_with_substeps_only_where_stiff_are_those_with_every_substep() {
+    for name in ["lab-double-pendulum-A0.yml", "lab-double-pendulum-B0.yml"] {
+        let robot = lab_robot(name);
+        let e_ref = 2.0;
+        let mut results = vec![];
+        for where_stiff in [true, false] {
+            let (built, _) = robot_controller::<2, 4>(&robot, Variant::Curved, e_ref, 0.5).unwrap();
+            let mut config = *built.config();
+            config.substeps_where_stiff = where_stiff;
+            let mut ctrl = eigenmpc::mpc::Controller::<_, 2, 4>::new(
+                *built.system(),
+                config,
+                built.reference().clone(),
+            )
+            .unwrap();
+            let z0 = SVector::<f64, 4>::new(START_ANGLE, START_ANGLE, 0.0, 0.0);
+            let trace = run(&mut ctrl, &robot, &z0, 30.0).unwrap();
+            let s = summarise(&trace, e_ref, None, 5.0);
+            let (mean, _) = energy_tail(&trace, e_ref, 5.0);
+            results.push((s.time_to_5_percent.unwrap(), mean, s.rms_torque));
+        }
+        let ((band, mean, torque), (band_all, mean_all, torque_all)) = (results[0], results[1]);
+        // Measured: A0 3.950 against 3.925 s, B0 5.225 against 5.225 s.
+        assert!(
+            (band - band_all).abs() <= 0.02 * band_all,
+            "{name}: {band} {band_all}"
+        );
+        assert!(
+            (mean - mean_all).abs() <= 0.005 * e_ref,
+            "{name}: {mean} {mean_all}"
+        );
+        for j in 0..2 {
+            let d = (torque[j] - torque_all[j]).abs() / torque_all[j];
+            assert!(d < 0.02, "{name}: RMS torque {torque} against {torque_all}");
+        }
+    }
+}
