@@ -25,15 +25,17 @@ pub enum Startup {
     Iterations(usize),
     /// The SQP with an L1-merit line search to convergence
     /// ([`MpcConfig::sqp`]; the paper's converged first sample): its time is
-    /// not bounded, 0.1-0.8 s on the laboratory robots, whose Coulomb
-    /// friction keeps it from converging within its iteration limit.
+    /// not bounded, 90-180 ms on the laboratory robots on the benchmark's
+    /// machine (two to three times that with the machine busy), whose
+    /// Coulomb friction keeps it from converging within its iteration
+    /// limit.
     Converge,
 }
 
 impl Startup {
     /// The default first sample's Gauss-Newton iterations: on the paper's
     /// pendulum and the laboratory robots the band time of the converged
-    /// start or better (docs/speed.md "First sample").
+    /// start or better (docs/speed.md, "The first sample").
     pub const DEFAULT_ITERATIONS: usize = 10;
 }
 

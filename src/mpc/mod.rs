@@ -16,7 +16,7 @@
 //! zero-torque guess and takes ten full Gauss-Newton iterations
 //! ([`Startup`]): bounded work, where the converged SQP with an L1-merit
 //! backtracking line search ([`Controller::solve_to_convergence`],
-//! `Startup::Converge`) took up to 0.8 s on robots with Coulomb friction.
+//! `Startup::Converge`) took 90-180 ms on robots with Coulomb friction.
 //! Everything is sized at creation; the per-sample path does not allocate.
 
 #[cfg(feature = "tooling")]

@@ -58,7 +58,7 @@ pub struct SimulateArgs {
     /// Shooting interval and sample period (s).
     #[arg(long, default_value_t = 0.025, allow_negative_numbers = true)]
     dt: f64,
-    /// RK4 substeps per interval (default: 1, or as many as the model's Coulomb friction needs).
+    /// RK4 substeps per interval, the most (default: 1, or as many as the model's Coulomb friction needs with a joint at rest; an interval in which no joint can stop takes fewer).
     #[arg(long)]
     substeps: Option<usize>,
     /// Torque bound (N m).
