@@ -66,7 +66,7 @@ per_sample() { # start qp variant [robot energy tau_max]
     done
     echo "| orbit | curved | clarabel | $(per_sample orbit clarabel curved) |"
     echo
-    echo "The robots of the table below (curved, riccati, from every joint at 0.05 rad at rest, the controller \`eigenmpc simulate --model FILE\` builds), thousands of instructions per sample from 10 s to 20 s (on the orbit for all of them by then):"
+    echo "The robots of the table below (curved, riccati, from every joint at 0.05 rad at rest, the controller \`eigenmpc simulate --model FILE\` builds), thousands of instructions per sample from 10 s to 20 s (the friction robots on their orbit by then; the paper's pendulum and the 3 point masses, at 14 J, still in the torque-limited climb):"
     echo
     echo "| robot | E_ref J | step (k instr.) | linearisation (k instr.) | QP solve (k instr.) |"
     echo "|---|---|---|---|---|"
