@@ -28,7 +28,7 @@ use crate::identify::{
 };
 use crate::mechanics::{PlanarChain, PlanarChainParams, Vector};
 use crate::modes::{ChartFamily, FamilyOptions};
-use crate::mpc::{Controller, prediction_substeps};
+use crate::mpc::{Controller, PREDICTION_SUBSTEPS, prediction_model};
 use nalgebra::SVector;
 use std::sync::{Arc, Condvar, Mutex};
 use std::thread::JoinHandle;
@@ -976,9 +976,10 @@ fn work<const N: usize, const NX: usize>(shared: &(Mutex<Slot<N>>, Condvar)) {
             let computed = PlanarChain::new(request.params)
                 .ok()
                 .and_then(|model| {
-                    // Other friction may need other prediction substeps
+                    // Other friction may need another prediction model
                     // (an eigenvalue problem: here, not in the sample).
-                    let substeps = prediction_substeps(&model, request.dt);
+                    let (model, substeps, _) =
+                        prediction_model(&model, request.dt, PREDICTION_SUBSTEPS);
                     match &request.family {
                         None => Some((model, None, substeps)),
                         Some((options, mode)) => {

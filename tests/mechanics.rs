@@ -151,6 +151,15 @@ fn check_dynamics_jacobian<const N: usize, S: MechanicalSystem<N>>(sys: &S, poin
         let fe_qd = fd_jacobian(|x| SVector::<f64, 1>::new(sys.energy(&q, x)), &qd);
         assert_close("dE/dq", &e_q.transpose(), &fe_q, 1e-7);
         assert_close("dE/dqd", &e_qd.transpose(), &fe_qd, 1e-7);
+        // The cost's fused evaluation: the same energy and gradient.
+        let (e, fused_q, fused_qd) = sys.energy_with_gradient(&q, &qd);
+        let scale = 1.0 + sys.energy(&q, &qd).abs();
+        assert!(
+            (e - sys.energy(&q, &qd)).abs() < 1e-13 * scale,
+            "fused energy {e}"
+        );
+        assert_close("fused dE/dq", &fused_q, &e_q, 1e-12);
+        assert_close("fused dE/dqd", &fused_qd, &e_qd, 1e-12);
 
         let grad = fd_jacobian(|x| SVector::<f64, 1>::new(sys.potential(x)), &q);
         assert_close(

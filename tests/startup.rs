@@ -1,11 +1,16 @@
 //! The first sample's start-up (`Startup`): bounded Gauss-Newton
 //! iterations by default, measured against the converged SQP they replaced
-//! on the laboratory robots, where Coulomb friction keeps the SQP from
-//! converging (docs/speed.md, "The first sample").
+//! on the laboratory robots, where their exact Coulomb law keeps the SQP
+//! from converging (docs/speed.md, "The first sample").
 
 use eigenmpc::model_file::RobotFile;
-use eigenmpc::mpc::closed_loop::{START_ANGLE, robot_controller, run, summarise};
-use eigenmpc::mpc::{ControlStatus, Controller, MpcConfig, MpcError, Startup, Variant};
+use eigenmpc::mpc::closed_loop::{
+    START_ANGLE, robot_controller, robot_controller_with, run, summarise,
+};
+use eigenmpc::mpc::{
+    ControlStatus, Controller, MpcConfig, MpcError, PREDICTION_SUBSTEPS, Startup, Variant,
+    prediction_substeps,
+};
 use nalgebra::SVector;
 
 fn lab_robot(name: &str) -> eigenmpc::mechanics::PlanarChain<2> {
@@ -17,9 +22,19 @@ fn lab_robot(name: &str) -> eigenmpc::mechanics::PlanarChain<2> {
 
 /// Band time, first-sample QP iterations and SQP iterations of 30 s from
 /// rest with `startup`.
-fn closed_loop(name: &str, startup: Startup) -> (f64, usize, usize, ControlStatus) {
+fn closed_loop(
+    name: &str,
+    startup: Startup,
+    exact_law: bool,
+) -> (f64, usize, usize, ControlStatus) {
     let robot = lab_robot(name);
-    let (built, _) = robot_controller::<2, 4>(&robot, Variant::Curved, 2.0, 0.5).unwrap();
+    let most = if exact_law {
+        prediction_substeps(&robot, 0.025)
+    } else {
+        PREDICTION_SUBSTEPS
+    };
+    let (built, _) =
+        robot_controller_with::<2, 4>(&robot, Variant::Curved, 2.0, 0.5, most).unwrap();
     let mut config = *built.config();
     config.startup = startup;
     let mut ctrl =
@@ -39,10 +54,11 @@ fn closed_loop(name: &str, startup: Startup) -> (f64, usize, usize, ControlStatu
 #[test]
 fn the_bounded_start_up_reaches_the_band_as_the_converged_sqp_on_the_lab_robots() {
     for name in ["lab-double-pendulum-A0.yml", "lab-double-pendulum-B0.yml"] {
+        // The robots' exact Coulomb law (the converged SQP's worst case).
         let (band, qp, sqp, status) =
-            closed_loop(name, Startup::Iterations(Startup::DEFAULT_ITERATIONS));
+            closed_loop(name, Startup::Iterations(Startup::DEFAULT_ITERATIONS), true);
         let (converged_band, converged_qp, converged_sqp, converged_status) =
-            closed_loop(name, Startup::Converge);
+            closed_loop(name, Startup::Converge, true);
         // The converged SQP runs into its iteration limit here (friction);
         // the bounded start takes its ten iterations and is done.
         assert_eq!(converged_status, ControlStatus::NotConverged, "{name}");
@@ -58,6 +74,20 @@ fn the_bounded_start_up_reaches_the_band_as_the_converged_sqp_on_the_lab_robots(
         assert!(
             band <= 1.02 * converged_band,
             "{name}: band {band} s, converged start {converged_band} s"
+        );
+        // The default model (its slope smoothed for two substeps): the
+        // converged SQP converges there (12 iterations on A0), and the
+        // bounded start is as good.
+        let (band, _, sqp, status) = closed_loop(
+            name,
+            Startup::Iterations(Startup::DEFAULT_ITERATIONS),
+            false,
+        );
+        let (converged_band, _, _, _) = closed_loop(name, Startup::Converge, false);
+        assert_eq!((sqp, status), (10, ControlStatus::Solved), "{name}");
+        assert!(
+            band <= 1.02 * converged_band,
+            "{name}: band {band} s, converged start {converged_band} s (default model)"
         );
     }
 }

@@ -585,15 +585,13 @@ impl<const N: usize> MechanicalSystem<N> for PlanarChain<N> {
         let gravity = self.gravity_amplitude.component_mul(&sin_phi);
         let w = Self::to_absolute_forces(&joint) - centrifugal - gravity;
 
-        let chol = mt.cholesky();
-        let solve = |b: &Matrix<N>| match &chol {
-            Some(ch) => ch.solve(b),
-            None => Matrix::<N>::repeat(f64::NAN),
-        };
-        let phidd = match &chol {
-            Some(ch) => ch.solve(&w),
-            None => Vector::<N>::repeat(f64::NAN),
-        };
+        // One inverse and four products: cheaper than a Cholesky solve for
+        // each of the 3 N + 1 right-hand sides (issue 22), and for two links
+        // the inverse is closed-form.
+        let mt_inv = spd_inverse(&mt).unwrap_or(Matrix::<N>::repeat(f64::NAN));
+        let phidd = mt_inv * w;
+        let l_inv = Self::l_inverse();
+        let response = l_inv * mt_inv;
 
         let phid_sq = phid.component_mul(&phid);
         // d(Mt phidd)/d phi: -diag(sum_l a_jl s_jl phidd_l) + a_jk s_jk phidd_k
@@ -613,7 +611,6 @@ impl<const N: usize> MechanicalSystem<N> for PlanarChain<N> {
         let d_grav = Matrix::<N>::from_diagonal(&self.gravity_amplitude.component_mul(&cos_phi));
 
         let l = Self::l_matrix();
-        let l_inv = Self::l_inverse();
         let l_inv_t = l_inv.transpose();
         let springs = Matrix::<N>::from_diagonal(&self.stiffness());
 
@@ -622,9 +619,9 @@ impl<const N: usize> MechanicalSystem<N> for PlanarChain<N> {
 
         DynamicsJacobian {
             acceleration: l_inv * phidd,
-            d_q: l_inv * solve(&dw_dq),
-            d_qd: l_inv * solve(&dw_dqd),
-            d_tau: l_inv * solve(&l_inv_t),
+            d_q: response * dw_dq,
+            d_qd: response * dw_dqd,
+            d_tau: response * l_inv_t,
         }
     }
 
@@ -638,6 +635,52 @@ impl<const N: usize> MechanicalSystem<N> for PlanarChain<N> {
         let d_e_dqd = self.mass_matrix(q) * qd;
         (d_e_dq, d_e_dqd)
     }
+
+    fn energy_with_gradient(&self, q: &Vector<N>, qd: &Vector<N>) -> (f64, Vector<N>, Vector<N>) {
+        // In absolute angles, `qd' M qd = phid' Mt phid` (`M = L' Mt L`),
+        // from one set of sines and cosines.
+        let phi = Self::absolute(q);
+        let phid = Self::absolute(qd);
+        let (sin_phi, cos_phi, sin, cos) = trigonometry(&phi);
+        let momentum = (self.coupling.component_mul(&cos) + self.rotor_absolute) * phid;
+        let springs = self.spring_forces(q);
+        let mut energy = 0.5 * phid.dot(&momentum) - self.potential_offset;
+        for j in 0..N {
+            let d = q[j] - self.params.joints[j].rest_angle;
+            energy += self.gravity_amplitude[j] * (1.0 - cos_phi[j]) + 0.5 * springs[j] * d;
+        }
+        // dT/dphi_k = -phid_k sum_l a_kl s_kl phid_l, dV/dphi_k = G_k sin phi_k.
+        let a_sin = self.coupling.component_mul(&sin);
+        let d_phi =
+            self.gravity_amplitude.component_mul(&sin_phi) - phid.component_mul(&(a_sin * phid));
+        (
+            energy,
+            Self::to_joint_forces(&d_phi) + springs,
+            Self::to_joint_forces(&momentum),
+        )
+    }
+}
+
+/// The inverse of a symmetric positive definite `m`, `None` when it is not
+/// (numerically) positive definite. Two links: the closed form.
+#[inline]
+fn spd_inverse<const N: usize>(m: &Matrix<N>) -> Option<Matrix<N>> {
+    if N == 2 {
+        let (a, b, d) = (m[(0, 0)], m[(0, 1)], m[(1, 1)]);
+        let det = a * d - b * b;
+        // The same test a Cholesky factorisation makes (both pivots > 0).
+        if !(a > 0.0 && det > 0.0) {
+            return None;
+        }
+        let s = 1.0 / det;
+        let mut inv = Matrix::<N>::zeros();
+        inv[(0, 0)] = d * s;
+        inv[(0, 1)] = -b * s;
+        inv[(1, 0)] = -b * s;
+        inv[(1, 1)] = a * s;
+        return Some(inv);
+    }
+    m.cholesky().map(|c| c.inverse())
 }
 
 /// `sin phi_j`, `cos phi_j` and the relative `sin(phi_j - phi_l)`,

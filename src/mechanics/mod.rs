@@ -66,6 +66,15 @@ pub trait MechanicalSystem<const N: usize> {
     /// Exact gradient of the energy: `(dE/dq, dE/dqd)`.
     fn energy_gradient(&self, q: &Vector<N>, qd: &Vector<N>) -> (Vector<N>, Vector<N>);
 
+    /// The energy with its exact gradient, `(E, dE/dq, dE/dqd)`, as
+    /// [`energy`](Self::energy) and [`energy_gradient`](Self::energy_gradient)
+    /// give them. The cost evaluates both at every stage: an implementor
+    /// shares their trigonometry here.
+    fn energy_with_gradient(&self, q: &Vector<N>, qd: &Vector<N>) -> (f64, Vector<N>, Vector<N>) {
+        let (d_q, d_qd) = self.energy_gradient(q, qd);
+        (self.energy(q, qd), d_q, d_qd)
+    }
+
     /// Joint friction torques `tau_f(qd)`, opposing the motion (zero for a
     /// conservative system). Each joint's friction depends on its own speed.
     fn friction(&self, _qd: &Vector<N>) -> Vector<N> {
@@ -168,6 +177,9 @@ where
     }
     fn energy_gradient(&self, q: &Vector<N>, qd: &Vector<N>) -> (Vector<N>, Vector<N>) {
         self.0.energy_gradient(q, qd)
+    }
+    fn energy_with_gradient(&self, q: &Vector<N>, qd: &Vector<N>) -> (f64, Vector<N>, Vector<N>) {
+        self.0.energy_with_gradient(q, qd)
     }
     fn conservative_forward_dynamics(
         &self,

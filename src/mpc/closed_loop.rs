@@ -458,29 +458,38 @@ where
 
 /// The controller `eigenmpc simulate --model FILE` builds for a robot: the
 /// paper's set-up (in-phase family, `E_ref = energy`, `|tau| <= tau_max`)
-/// with the robot's prediction model, the RK4 substeps and Coulomb slope its
-/// friction needs ([`super::prediction_substeps`]); and the model's
-/// eigenmode at `energy` (the distance metric's path).
+/// with the robot's prediction model ([`super::prediction_model`], at most
+/// [`super::PREDICTION_SUBSTEPS`] RK4 substeps and the Coulomb slope they
+/// take); and the model's eigenmode at `energy` (the distance metric's path).
 pub fn robot_controller<const N: usize, const NX: usize>(
     robot: &crate::mechanics::PlanarChain<N>,
     variant: super::Variant,
     energy: f64,
     tau_max: f64,
-) -> Result<
-    (
-        Controller<crate::mechanics::PlanarChain<N>, N, NX>,
-        crate::modes::Eigenmode<N>,
-    ),
-    String,
-> {
+) -> Result<RobotController<N, NX>, String> {
+    robot_controller_with(robot, variant, energy, tau_max, super::PREDICTION_SUBSTEPS)
+}
+
+/// A controller of [`robot_controller`] and the eigenmode it follows.
+pub type RobotController<const N: usize, const NX: usize> = (
+    Controller<crate::mechanics::PlanarChain<N>, N, NX>,
+    crate::modes::Eigenmode<N>,
+);
+
+/// [`robot_controller`] with at most `most_substeps` RK4 substeps per
+/// interval ([`super::prediction_substeps`] of the robot: its exact law).
+pub fn robot_controller_with<const N: usize, const NX: usize>(
+    robot: &crate::mechanics::PlanarChain<N>,
+    variant: super::Variant,
+    energy: f64,
+    tau_max: f64,
+    most_substeps: usize,
+) -> Result<RobotController<N, NX>, String> {
     let mut config = super::MpcConfig::paper(variant);
-    config.substeps = super::prediction_substeps(robot, config.dt);
+    let (model, substeps, _) = super::prediction_model(robot, config.dt, most_substeps);
+    config.substeps = substeps;
     config.tau_max = tau_max;
     config.cost.e_ref = energy;
-    let sharpness = super::prediction_coulomb_sharpness(robot, config.dt / config.substeps as f64);
-    let model = robot
-        .with_coulomb_sharpness(sharpness)
-        .map_err(|e| e.to_string())?;
     let (mode, chart) =
         mode_and_chart::<_, N, NX>(&model, 0, energy, 9).map_err(|e| e.to_string())?;
     let reference = super::Reference::with_chart(variant, chart);

@@ -41,7 +41,10 @@ pub use cost::{
     Variant, VariantInfo, Weights,
 };
 pub use estimator::EstimatorConfig;
-pub use prediction::{prediction_coulomb_sharpness, prediction_substeps};
+pub use prediction::{
+    FrictionSmoothing, PREDICTION_SUBSTEPS, prediction_coulomb_sharpness, prediction_model,
+    prediction_substeps,
+};
 pub use saved::ControllerState;
 pub use status::{ControlOutput, ControlStatus};
 

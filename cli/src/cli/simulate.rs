@@ -14,8 +14,8 @@ use eigenmpc::mpc::closed_loop::{
     summarise,
 };
 use eigenmpc::mpc::{
-    Controller, EstimatorConfig, MpcConfig, QpBackend, Reference, Variant,
-    prediction_coulomb_sharpness, prediction_substeps,
+    Controller, EstimatorConfig, FrictionSmoothing, MpcConfig, PREDICTION_SUBSTEPS, QpBackend,
+    Reference, Variant, prediction_coulomb_sharpness, prediction_substeps,
 };
 use eigenmpc_cli::adaptation::{self, AdaptationSample, base_parameter_names};
 use eigenmpc_cli::report::{
@@ -361,7 +361,7 @@ fn run_simulate_for<const N: usize, const S: usize, const NP: usize>(
     config.dt = args.dt;
     config.substeps = args
         .substeps
-        .unwrap_or_else(|| prediction_substeps(&system, args.dt));
+        .unwrap_or_else(|| prediction_substeps(&system, args.dt).min(PREDICTION_SUBSTEPS));
     config.tau_max = args.tau_max;
     config.iterations_per_sample = args.iterations;
     config.qp = backend;
@@ -553,9 +553,9 @@ fn run_simulate_for<const N: usize, const S: usize, const NP: usize>(
             t.norm() / f.norm()
         );
         println!(
-            "prediction model:               Coulomb slope k = {sharpness:.4} s/rad (model {}), {} RK4 substeps",
-            system.params().coulomb_sharpness,
-            config.substeps
+            "prediction model:               {} RK4 substeps, {}",
+            config.substeps,
+            FrictionSmoothing::new(system.params().coulomb_sharpness, sharpness).describe()
         );
     }
     // The plant's base parameters (None with joint springs: its energy is

@@ -29,7 +29,7 @@ use crate::enums::ADAPTATION_STATUS;
 use crate::units;
 use adaptive::AdaptiveController;
 use eigenmpc::adapt::AdaptationEvent;
-use eigenmpc::mpc::{ControlOutput, MpcConfig, Variant};
+use eigenmpc::mpc::{ControlOutput, FrictionSmoothing, MpcConfig, Variant};
 use fmi2_slave::table::{Element, Table};
 use fmi2_slave::{Context, DefaultExperiment, Model, ModelDescription, ModelError, Values};
 use nalgebra::SVector;
@@ -233,6 +233,18 @@ impl<P: ControllerProduct<N> + Send, const N: usize, const NX: usize, const NP: 
                 "mode family: computed now, not the exported one: {why}"
             )),
             _ => {}
+        }
+        // The prediction model's smoothed Coulomb law, and its error bound.
+        let predicted = controller.controller().system().params().coulomb_sharpness;
+        if let Ok(robot) = settings.system() {
+            let smoothing = FrictionSmoothing::new(robot.params().coulomb_sharpness, predicted);
+            if smoothing.largest > 0.0 {
+                ctx.log.event(&format!(
+                    "prediction model: {} RK4 substeps, {}",
+                    controller.controller().config().substeps,
+                    smoothing.describe()
+                ));
+            }
         }
         let mut model = Self {
             controller,

@@ -8,8 +8,8 @@ use eigenmpc::adapt::AdaptOptions;
 use eigenmpc::mechanics::{MechanicalSystem, PlanarChain, Vector};
 use eigenmpc::modes::{Chart, ChartFamily, FamilyOptions, linear_modes};
 use eigenmpc::mpc::{
-    Controller, CostParams, EstimatorConfig, Guide, MpcConfig, QpBackend, Reference, Variant,
-    Weights, prediction_substeps,
+    Controller, CostParams, EstimatorConfig, Guide, MpcConfig, PREDICTION_SUBSTEPS, QpBackend,
+    Reference, Variant, Weights, prediction_model,
 };
 
 /// Longest horizon the clarabel QP backend is offered for.
@@ -308,13 +308,15 @@ impl<const N: usize> Settings<N> {
         }
         let system = self.system()?;
         let mut config = self.config();
-        // A model with Coulomb friction needs RK4 substeps to predict its
-        // stiff law near zero speed (1 for a frictionless model).
-        config.substeps = prediction_substeps(&system, config.dt);
+        // A model with Coulomb friction predicts with RK4 substeps and a
+        // slope they can take (the robot itself without it); the reference
+        // and the mode family are the robot's (friction does not enter).
+        let (model, substeps, _) = prediction_model(&system, config.dt, PREDICTION_SUBSTEPS);
+        config.substeps = substeps;
         match self.chart_source {
             ChartSource::Parameters => {
                 let reference = self.reference(&system)?;
-                let c = Controller::new(system, config, reference).map_err(|e| e.to_string())?;
+                let c = Controller::new(model, config, reference).map_err(|e| e.to_string())?;
                 Ok((c, None))
             }
             // A chart variant follows the family over E_ref.
@@ -326,14 +328,14 @@ impl<const N: usize> Settings<N> {
                     },
                     None => (self.family::<NX>(&system)?, None),
                 };
-                let c = Controller::with_family_as(system, config, family, self.variant)
+                let c = Controller::with_family_as(model, config, family, self.variant)
                     .map_err(|e| e.to_string())?;
                 Ok((c, refused))
             }
             ChartSource::Computed => {
                 let eigenvector = self.linear_mode(&system)?;
                 let reference = Reference::new(self.variant, Guide::Line(eigenvector))?;
-                let c = Controller::new(system, config, reference).map_err(|e| e.to_string())?;
+                let c = Controller::new(model, config, reference).map_err(|e| e.to_string())?;
                 Ok((c, None))
             }
         }
@@ -405,7 +407,8 @@ mod tests {
     use super::*;
     use eigenmpc::mechanics::{Joint, PlanarChainParams};
 
-    /// A controller model with Coulomb friction predicts with substeps;
+    /// A controller model with Coulomb friction predicts with two substeps
+    /// and the slope they take;
     /// the paper's frictionless model keeps one RK4 step per interval.
     #[test]
     fn a_friction_model_gets_prediction_substeps() {
@@ -423,6 +426,15 @@ mod tests {
         }; 2];
         s.model = ChainParameters::from_params(&p).unwrap();
         let c = s.build::<4>().unwrap();
-        assert!(c.config().substeps > 1, "{}", c.config().substeps);
+        assert_eq!(c.config().substeps, PREDICTION_SUBSTEPS);
+        // The slope lowered to what two substeps take: the stiffest
+        // friction mode at RK4's margin, not beyond it.
+        let k = c.system().params().coulomb_sharpness;
+        let h = c.config().dt / PREDICTION_SUBSTEPS as f64;
+        let rate = eigenmpc::mpc::prediction::coulomb_rate_per_slope(c.system());
+        assert!(k < 100.0, "{k}");
+        assert!(
+            (h * rate * k - eigenmpc::mpc::prediction::PREDICTION_FRICTION_STEP_LIMIT).abs() < 1e-9
+        );
     }
 }

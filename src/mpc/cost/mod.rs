@@ -161,8 +161,7 @@ where
     S: MechanicalSystem<N> + ?Sized,
 {
     let (q, qd) = unpack_state::<N, NX>(z);
-    let energy = system.energy(&q, &qd);
-    let (de_dq, de_dqd) = system.energy_gradient(&q, &qd);
+    let (energy, de_dq, de_dqd) = system.energy_with_gradient(&q, &qd);
     let mut grad_e = SVector::<f64, NX>::zeros();
     grad_e.fixed_rows_mut::<N>(0).copy_from(&de_dq);
     grad_e.fixed_rows_mut::<N>(N).copy_from(&de_dqd);
