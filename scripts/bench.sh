@@ -78,7 +78,7 @@ per_sample() { # start qp variant [robot energy tau_max]
     echo
     echo "## The first sample"
     echo
-    echo "The first sample starts from a zero-torque guess. \`Startup::Iterations(n)\` (the default: 10) takes n full Gauss-Newton iterations in it, one linearisation and one QP each: bounded work. \`Startup::Converge\` is the paper's converged SQP with its L1-merit line search (at most 30 iterations): on the laboratory robots the Coulomb friction keeps it from converging, so it always runs to that limit, with many step halvings. Curved, riccati, N = 80, 30 s from every joint at 0.05 rad at rest, the controller \`eigenmpc simulate --model FILE\` builds (\`cargo run --release --example startup\`); times on the machine above:"
+    echo "The first sample starts from a zero-torque guess. \`Startup::Iterations(n)\` (the default: 10) takes n full Gauss-Newton iterations in it, one linearisation and one QP each: bounded work. \`Startup::Converge\` is the paper's converged SQP with its L1-merit line search (at most 30 iterations): on the laboratory robots it takes tens of milliseconds, with many step halvings (with their exact Coulomb law, before the prediction model smoothed it for three substeps, it never converged and took 90-180 ms). Curved, riccati, N = 80, 30 s from every joint at 0.05 rad at rest, the controller \`eigenmpc simulate --model FILE\` builds (\`cargo run --release --example startup\`); times on the machine above:"
     echo
     "$target_dir/release/examples/startup"
 } > "$out.tmp"

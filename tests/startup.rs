@@ -75,8 +75,8 @@ fn the_bounded_start_up_reaches_the_band_as_the_converged_sqp_on_the_lab_robots(
             band <= 1.02 * converged_band,
             "{name}: band {band} s, converged start {converged_band} s"
         );
-        // The default model (its slope smoothed for two substeps): the
-        // converged SQP converges there (12 iterations on A0), and the
+        // The default model (its slope smoothed for its substeps): the
+        // converged SQP takes 17-72 ms there (docs/speed.md), and the
         // bounded start is as good.
         let (band, _, sqp, status) = closed_loop(
             name,

@@ -12,13 +12,15 @@
 //! rest ([`prediction_coulomb_sharpness`]): a step-aware smoothing. It
 //! underestimates the friction only at low speeds; [`FrictionSmoothing`]
 //! bounds the error and says up to which speed it exceeds 1 %. Measured on
-//! the laboratory robots A0 and B0 (docs/speed.md, issue 22), two substeps
-//! (`k` 25 and 15 where the law has 100) against the exact law with 9 and 14:
-//! band times within 0.5 % (A0 3.80 against 3.95 s), tail energy within
-//! 0.7 % of E_ref of the exact law's, RMS torque 1-7 % lower, at 0.6x the
-//! per-sample time. One substep (`k` ~ 12) leaves the energy 1.2 % low
-//! on B0 at 4 J; the slope `k` ~ 5 an older model took for one step kept
-//! A0 from starting at 1 J. An interval in which every joint stays fast
+//! the laboratory robots A0 and B0 (README, issue 22), three substeps (`k`
+//! 37 and 22 where the law has 100) against the exact law with 9 and 14:
+//! band times within 3 %, tail energy within 1 % of E_ref of the exact
+//! law's (B0 at 2 J: -0.40 against +0.54 %; at 4 J: -0.70 against -0.49
+//! %), RMS torque up to 6 % lower, at half the per-sample time.
+//! Two substeps left B0 at 4 J 1.2 % low (outside a 1 % band the exact law
+//! keeps), one 1.2 % and A0 at 1 J 0.6 %; the slope `k` ~ 5 an older
+//! model took for one step kept A0 from starting at 1 J. An interval in
+//! which every joint stays fast
 //! takes fewer substeps still ([`super::MpcConfig::substeps_where_stiff`]).
 //! The exact law stays available: `prediction_model(chain, dt,
 //! prediction_substeps(chain, dt))` (up to [`MAX_PREDICTION_SUBSTEPS`]).
@@ -34,7 +36,7 @@ pub const MAX_PREDICTION_SUBSTEPS: usize = 20;
 
 /// RK4 substeps per interval the default prediction model takes at most
 /// (its Coulomb slope lowered to fit; see the module documentation).
-pub const PREDICTION_SUBSTEPS: usize = 2;
+pub const PREDICTION_SUBSTEPS: usize = 3;
 
 /// How far a prediction model's smoothed Coulomb law `cf atan(k' v)` is from
 /// the robot's `cf atan(k v)` (`k' <= k`): the model underestimates the
@@ -221,12 +223,16 @@ mod tests {
     }
 
     #[test]
-    fn the_default_model_takes_two_substeps_and_the_slope_they_allow() {
+    fn the_default_model_takes_its_substeps_and_the_slope_they_allow() {
         let chain = rough_chain();
+        assert!(prediction_substeps(&chain, 0.025) > PREDICTION_SUBSTEPS);
         let (model, substeps, smoothing) = prediction_model(&chain, 0.025, PREDICTION_SUBSTEPS);
-        assert_eq!(substeps, 2);
+        assert_eq!(substeps, PREDICTION_SUBSTEPS);
         let k = model.params().coulomb_sharpness;
-        assert_eq!(k, prediction_coulomb_sharpness(&chain, 0.0125));
+        assert_eq!(
+            k,
+            prediction_coulomb_sharpness(&chain, 0.025 / PREDICTION_SUBSTEPS as f64)
+        );
         assert_eq!(smoothing.model_sharpness, k);
         // Everything but the slope is the robot's.
         let mut back = *model.params();

@@ -407,7 +407,7 @@ mod tests {
     use super::*;
     use eigenmpc::mechanics::{Joint, PlanarChainParams};
 
-    /// A controller model with Coulomb friction predicts with two substeps
+    /// A controller model with Coulomb friction predicts with its substeps
     /// and the slope they take;
     /// the paper's frictionless model keeps one RK4 step per interval.
     #[test]
@@ -427,7 +427,7 @@ mod tests {
         s.model = ChainParameters::from_params(&p).unwrap();
         let c = s.build::<4>().unwrap();
         assert_eq!(c.config().substeps, PREDICTION_SUBSTEPS);
-        // The slope lowered to what two substeps take: the stiffest
+        // The slope lowered to what its substeps take: the stiffest
         // friction mode at RK4's margin, not beyond it.
         let k = c.system().params().coulomb_sharpness;
         let h = c.config().dt / PREDICTION_SUBSTEPS as f64;
