@@ -20,7 +20,8 @@
 //! `cf atan(k qd)` (`k` = [`PlanarChainParams::coulomb_sharpness`], 100 1/(rad/s)
 //! in the shared parameter files; it tends to `cf pi/2` at speed).
 
-use super::{DynamicsJacobian, Matrix, MechanicalSystem, Vector};
+use super::{DynamicsJacobian, Matrix, MechanicalSystem, Vector, sin_cos};
+use nalgebra::SMatrix;
 use thiserror::Error;
 
 /// One rigid link.
@@ -446,6 +447,42 @@ impl<const N: usize> PlanarChain<N> {
         })
     }
 
+    /// `x L`: column `j` is the sum of the columns `j..N` of `x`.
+    #[inline(always)]
+    fn times_l(x: &Matrix<N>) -> Matrix<N> {
+        let mut out = *x;
+        for j in (0..N.saturating_sub(1)).rev() {
+            for i in 0..N {
+                out[(i, j)] += out[(i, j + 1)];
+            }
+        }
+        out
+    }
+
+    /// `L^-1 x` (`x` a vector or a matrix): row `j` less row `j - 1`.
+    #[inline(always)]
+    fn l_inverse_times<const C: usize>(x: &SMatrix<f64, N, C>) -> SMatrix<f64, N, C> {
+        let mut out = *x;
+        for j in 1..N {
+            for c in 0..C {
+                out[(j, c)] -= x[(j - 1, c)];
+            }
+        }
+        out
+    }
+
+    /// `x L^-T`: column `j` less column `j - 1`.
+    #[inline(always)]
+    fn times_l_inverse_t(x: &Matrix<N>) -> Matrix<N> {
+        let mut out = *x;
+        for j in 1..N {
+            for i in 0..N {
+                out[(i, j)] -= x[(i, j - 1)];
+            }
+        }
+        out
+    }
+
     /// Inertia in absolute angles `Mt(phi)`, rotors included.
     fn absolute_mass_matrix(&self, phi: &Vector<N>) -> Matrix<N> {
         self.coupling.component_mul(&relative_sin_cos(phi).1) + self.rotor_absolute
@@ -590,8 +627,9 @@ impl<const N: usize> MechanicalSystem<N> for PlanarChain<N> {
         // the inverse is closed-form.
         let mt_inv = spd_inverse(&mt).unwrap_or(Matrix::<N>::repeat(f64::NAN));
         let phidd = mt_inv * w;
-        let l_inv = Self::l_inverse();
-        let response = l_inv * mt_inv;
+        // L, L^-1 and L^-T are sums and differences of neighbours: applied
+        // as such, not as dense products (a third of the arithmetic here).
+        let response = Self::l_inverse_times(&mt_inv);
 
         let phid_sq = phid.component_mul(&phid);
         // d(Mt phidd)/d phi: -diag(sum_l a_jl s_jl phidd_l) + a_jk s_jk phidd_k
@@ -610,18 +648,22 @@ impl<const N: usize> MechanicalSystem<N> for PlanarChain<N> {
         let d_cent_phid = Matrix::<N>::from_fn(|j, k| 2.0 * a_sin[(j, k)] * phid[k]);
         let d_grav = Matrix::<N>::from_diagonal(&self.gravity_amplitude.component_mul(&cos_phi));
 
-        let l = Self::l_matrix();
-        let l_inv_t = l_inv.transpose();
-        let springs = Matrix::<N>::from_diagonal(&self.stiffness());
-
-        let dw_dq = (-d_cent_phi - d_grav - d_mass) * l - l_inv_t * springs;
-        let dw_dqd = -d_cent_phid * l;
+        // dw/dq = (-dh/dphi - dG/dphi - d(Mt phidd)/dphi) L - L^-T K.
+        let mut dw_dq = Self::times_l(&(-d_cent_phi - d_grav - d_mass));
+        let springs = self.stiffness();
+        for j in 0..N {
+            dw_dq[(j, j)] -= springs[j];
+            if j + 1 < N {
+                dw_dq[(j, j + 1)] += springs[j + 1];
+            }
+        }
+        let dw_dqd = -Self::times_l(&d_cent_phid);
 
         DynamicsJacobian {
-            acceleration: l_inv * phidd,
+            acceleration: Self::l_inverse_times(&phidd),
             d_q: response * dw_dq,
             d_qd: response * dw_dqd,
-            d_tau: response * l_inv_t,
+            d_tau: Self::times_l_inverse_t(&response),
         }
     }
 
@@ -684,15 +726,16 @@ fn spd_inverse<const N: usize>(m: &Matrix<N>) -> Option<Matrix<N>> {
 }
 
 /// `sin phi_j`, `cos phi_j` and the relative `sin(phi_j - phi_l)`,
-/// `cos(phi_j - phi_l)` from N libm sine-cosine pairs: the relative ones by
+/// `cos(phi_j - phi_l)` from N sine-cosine pairs: the relative ones by
 /// the difference formulas (to a few ulps of the direct values). The libm
-/// calls were 12 % of an RTI sample on the orbit (issue 12).
+/// calls were 12 % of an RTI sample on the orbit (issue 12); the pairs are
+/// [`sin_cos`]'s (about half of libm's instructions).
 #[inline]
 fn trigonometry<const N: usize>(phi: &Vector<N>) -> (Vector<N>, Vector<N>, Matrix<N>, Matrix<N>) {
     let mut sin_phi = Vector::<N>::zeros();
     let mut cos_phi = Vector::<N>::zeros();
     for j in 0..N {
-        (sin_phi[j], cos_phi[j]) = phi[j].sin_cos();
+        (sin_phi[j], cos_phi[j]) = sin_cos(phi[j]);
     }
     let mut sin = Matrix::<N>::zeros();
     let mut cos = Matrix::<N>::identity();
@@ -718,7 +761,7 @@ fn relative_sin_cos<const N: usize>(phi: &Vector<N>) -> (Matrix<N>, Matrix<N>) {
     let mut cos = Matrix::<N>::identity();
     for j in 0..N {
         for l in j + 1..N {
-            let (s, c) = (phi[j] - phi[l]).sin_cos();
+            let (s, c) = sin_cos(phi[j] - phi[l]);
             sin[(j, l)] = s;
             sin[(l, j)] = -s;
             cos[(j, l)] = c;
@@ -749,8 +792,8 @@ mod tests {
         let phi = Vector::<3>::new(0.3, -1.7, 2.9);
         let (sin_phi, cos_phi, sin, cos) = trigonometry(&phi);
         for j in 0..3 {
-            assert_eq!(sin_phi[j], phi[j].sin());
-            assert_eq!(cos_phi[j], phi[j].cos());
+            assert!((sin_phi[j] - phi[j].sin()).abs() <= 2.3e-16);
+            assert!((cos_phi[j] - phi[j].cos()).abs() <= 2.3e-16);
             for l in 0..3 {
                 assert!((sin[(j, l)] - (phi[j] - phi[l]).sin()).abs() < 4.0 * f64::EPSILON);
                 assert!((cos[(j, l)] - (phi[j] - phi[l]).cos()).abs() < 4.0 * f64::EPSILON);

@@ -7,11 +7,14 @@
 //! time), because stable Rust cannot yet write `2 * N` in a type.
 
 mod chain;
+mod trig;
 
 pub use chain::{
     DEFAULT_COULOMB_SHARPNESS, DoublePendulum, Joint, Link, ParamsError, PlanarChain,
     PlanarChainParams,
 };
+
+pub use trig::sin_cos;
 
 use nalgebra::{SMatrix, SVector};
 

@@ -229,11 +229,14 @@ pub(super) struct FixedCore<const NX: usize, const NU: usize, const M: usize> {
     pub(super) warm: bool,
     /// Some state component has a soft bound (no active-set start).
     soft_any: bool,
-    /// Per stage: the costates and multipliers kept aside while the
-    /// active-set start runs (the interior point's warm start when it fails).
-    kept: Vec<(Vecn<NX>, [f64; M])>,
+    /// Per stage: the costates kept aside while the active-set start runs
+    /// (with the untouched multipliers, the interior point's warm start
+    /// when it fails).
+    kept: Vec<Vecn<NX>>,
     /// Per stage: the active-set start's guess, policy and cost-to-go.
     guess: Vec<GuessStage<NX, NU>>,
+    /// The controls' stationarity scale of the active-set start's last sweep.
+    guess_scale: f64,
 }
 
 impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
@@ -251,8 +254,9 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
             info: RiccatiInfo::default(),
             warm: false,
             soft_any: false,
-            kept: vec![(Vecn::zeros(), [0.0; M]); horizon + 1],
+            kept: vec![Vecn::zeros(); horizon + 1],
             guess: vec![GuessStage::new(); horizon + 1],
+            guess_scale: 0.0,
         }
     }
 

@@ -16,7 +16,7 @@
 //! warm start. The empty guess is the inactive-set start: on an eigenmode
 //! the torques are far from their bounds and one recursion solves the QP.
 
-use super::{Core, FixedCore, Mat, RiccatiInfo, Vecn};
+use super::{Core, FixedCore, Mat, Residuals, RiccatiInfo, Vecn, fmax, nan_probe};
 use crate::qp::{QpSolution, QpStatus};
 
 /// A previous multiplier above this marks an active bound of the guess.
@@ -70,8 +70,10 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
             return None;
         }
         // The interior point's warm start reads these if no guess is right.
+        // The sweeps overwrite the costates; the multipliers change only
+        // once a guess is accepted.
         for (st, kept) in self.st.iter().zip(self.kept.iter_mut()) {
-            *kept = (st.pi, st.lam);
+            *kept = st.pi;
         }
         self.first_guess();
         let mut guesses = 0;
@@ -88,10 +90,9 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
             }
         };
         // An optimal guess's solution and multipliers become the iterate,
-        // checked by the same residuals as the interior point's.
+        // checked against the interior point's tolerances.
         let accepted = optimal && {
-            self.set_multipliers();
-            let res = Core::residuals(self);
+            let res = self.guess_residuals();
             let set = &self.set;
             let tol_stat = set
                 .tol_stationarity
@@ -103,12 +104,12 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
         };
         if !accepted {
             for (st, kept) in self.st.iter_mut().zip(&self.kept) {
-                st.pi = kept.0;
-                st.lam = kept.1;
+                st.pi = *kept;
             }
             self.info = RiccatiInfo::default();
             return None;
         }
+        self.set_multipliers();
         self.info.iterations = guesses;
         self.info.active_set_start = true;
         self.write_solution(sol);
@@ -193,18 +194,16 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
                     rhs[j] = fixed[j];
                 }
             }
-            let Some(chol) = hm.cholesky() else {
+            // The core's fixed-size Cholesky (a generic factor and solve
+            // cost several times more at these sizes); a pivot it would
+            // lift is one that is not clearly positive.
+            let diag = hm.diagonal();
+            let mut inv = Vecn::<NU>::zeros();
+            if Self::cholesky(&mut hm, &mut inv, &diag, Some(0.0), tol) > 0 {
                 return false;
-            };
-            let l = chol.l_dirty();
-            for j in 0..NU {
-                let pivot = l[(j, j)] * l[(j, j)];
-                if pivot.is_nan() || pivot <= tol * hm[(j, j)].abs() {
-                    return false;
-                }
             }
-            let gain = -chol.solve(&g);
-            let mut feed = chol.solve(&rhs);
+            let gain = -llt_solve(&hm, &inv, &g);
+            let mut feed = llt_solve(&hm, &inv, &rhs);
             for j in 0..NU {
                 if guess[j] != Bound::Free {
                     feed[j] = fixed[j];
@@ -232,6 +231,7 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
         let n = self.n;
         let (tol_stat, tol_feas) = (self.set.tol_stationarity, self.set.tol_feasibility);
         let mut changed = 0;
+        let mut scale = 0.0f64;
         self.st[0].x = self.x0;
         for k in 0..n {
             let gs = &self.guess[k];
@@ -242,7 +242,14 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
             let pi = p_next * x_next + pv_next;
             // Gradient of the Lagrangian without the bound multipliers:
             // lam_lower = grad, lam_upper = -grad on the fixed controls.
-            let grad = st.r * u + st.s * st.x + st.rl + st.b.tr_mul(&pi);
+            let (h, e) = (st.r * u + st.s * st.x, st.b.tr_mul(&pi));
+            let grad = h + st.rl + e;
+            for j in 0..NU {
+                // The stationarity's scale, as the interior point's residuals
+                // take it (guess_residuals adds the multipliers).
+                let terms = fmax(fmax(st.rl[j].abs(), h[j].abs()), e[j].abs());
+                scale = fmax(scale, terms);
+            }
             let mut guess = gs.guess;
             for j in 0..NU {
                 let next = match guess[j] {
@@ -264,7 +271,69 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
             st.ru = grad;
             self.st[k + 1].x = x_next;
         }
+        self.guess_scale = scale;
         changed
+    }
+
+    /// The optimality residuals the interior point's [`Core::residuals`]
+    /// finds at an optimal guess with [`Self::set_multipliers`]'
+    /// multipliers, from what the last sweep left (a third of the work):
+    /// each `x_{k+1}` came from the dynamics, so they hold exactly; no
+    /// state bound has a slot (`soft_any` is false); the controls'
+    /// gradients are in `ru`. What remains is the stationarity of the
+    /// controls (the gradient less the multiplier of a fixed bound, which
+    /// is the gradient clipped at zero) and of the states, and the
+    /// controls' bound violation.
+    fn guess_residuals(&self) -> Residuals {
+        let n = self.n;
+        let (mut stat_u, mut stat_x, mut feas) = ([0.0f64; NU], [0.0f64; NX], [0.0f64; NU]);
+        let (mut scale, mut probe) = (self.guess_scale, 0.0);
+        for k in 0..=n {
+            let st = &self.st[k];
+            if k < n {
+                let guess = &self.guess[k].guess;
+                for j in 0..NU {
+                    let grad = st.ru[j];
+                    let (v, multiplier) = match guess[j] {
+                        Bound::Lower => (grad.min(0.0), grad.max(0.0)),
+                        Bound::Upper => (grad.max(0.0), (-grad).max(0.0)),
+                        Bound::Free => (grad, 0.0),
+                    };
+                    scale = fmax(scale, multiplier);
+                    stat_u[j] = fmax(stat_u[j], v.abs());
+                    probe += nan_probe(v);
+                    let below = -st.mask[j] * (st.u[j] + st.off[j]);
+                    let above = st.mask[NU + j] * (st.u[j] - st.off[NU + j]);
+                    feas[j] = fmax(feas[j], fmax(below, above));
+                }
+            }
+            if k >= 1 {
+                // x_0 is fixed: its row is not a condition; the last stage
+                // has no costate of its own.
+                let prev = self.st[k - 1].pi;
+                let h = st.q * st.x + st.s.tr_mul(&st.u);
+                let e = if k < n {
+                    st.a.tr_mul(&st.pi)
+                } else {
+                    Vecn::zeros()
+                };
+                for i in 0..NX {
+                    let v = st.ql[i] + h[i] + e[i] - prev[i];
+                    let terms = fmax(fmax(st.ql[i].abs(), h[i].abs()), e[i].abs());
+                    scale = fmax(scale, fmax(terms, prev[i].abs()));
+                    stat_x[i] = fmax(stat_x[i], v.abs());
+                    probe += nan_probe(v);
+                }
+            }
+        }
+        let max = |v: &[f64]| v.iter().fold(0.0, |a, &b| fmax(a, b));
+        Residuals {
+            stationarity: fmax(max(&stat_u), max(&stat_x)) + probe,
+            scale,
+            feasibility: max(&feas),
+            complementarity: 0.0,
+            mu: 0.0,
+        }
     }
 
     /// Slacks and multipliers of the optimal guess: multipliers from the
@@ -301,4 +370,34 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
             }
         }
     }
+}
+
+/// `(L L')^-1 b` for the lower factor `l` with reciprocal pivots `inv`
+/// (as [`FixedCore::cholesky`] leaves them).
+#[inline(always)]
+fn llt_solve<const D: usize, const C: usize>(
+    l: &Mat<D, D>,
+    inv: &Vecn<D>,
+    b: &Mat<D, C>,
+) -> Mat<D, C> {
+    let mut y = *b;
+    for j in 0..D {
+        for c in 0..C {
+            let mut v = y[(j, c)];
+            for i in 0..j {
+                v -= l[(j, i)] * y[(i, c)];
+            }
+            y[(j, c)] = v * inv[j];
+        }
+    }
+    for j in (0..D).rev() {
+        for c in 0..C {
+            let mut v = y[(j, c)];
+            for i in j + 1..D {
+                v -= l[(i, j)] * y[(i, c)];
+            }
+            y[(j, c)] = v * inv[j];
+        }
+    }
+    y
 }
