@@ -142,6 +142,24 @@ pub fn rk4_step_sensitivity<S, const N: usize, const NX: usize>(
 where
     S: MechanicalSystem<N> + ?Sized,
 {
+    let (q, qd) = unpack_state::<N, NX>(z);
+    let first = system.dynamics_jacobian(&q, &qd, tau);
+    rk4_step_sensitivity_from(system, z, tau, h, &first)
+}
+
+/// [`rk4_step_sensitivity`] given the dynamics Jacobian at `z` (the first
+/// stage's, which does not depend on `h`): a caller that needs the
+/// acceleration at `z` anyway, to choose the substeps, computes it once.
+pub fn rk4_step_sensitivity_from<S, const N: usize, const NX: usize>(
+    system: &S,
+    z: &SVector<f64, NX>,
+    tau: &Vector<N>,
+    h: f64,
+    first: &DynamicsJacobian<N>,
+) -> Rk4Sensitivity<N, NX>
+where
+    S: MechanicalSystem<N> + ?Sized,
+{
     // A stage's Jacobian is [0 I; Dq Dqd] (and [0; Dtau] for the torque):
     // products with it take the lower block rows only, half of a dense
     // product (issue 12).
@@ -151,7 +169,8 @@ where
         let jac = system.dynamics_jacobian(&q, &qd, tau);
         (pack_state::<N, NX>(&qd, &jac.acceleration), jac)
     };
-    let (k1, j1) = stage(z);
+    let (_, qd) = unpack_state::<N, NX>(z);
+    let (k1, j1) = (pack_state::<N, NX>(&qd, &first.acceleration), *first);
     let (dk1_z, dk1_u) = (
         jacobian_times::<N, NX, NX>(&j1, &eye),
         torque_column::<N, NX>(&j1),

@@ -3,8 +3,8 @@
 
 use super::Controller;
 use super::cost::stage_model;
-use crate::integrate::rk4_step_sensitivity;
-use crate::mechanics::{MechanicalSystem, Vector, unpack_state};
+use crate::integrate::{rk4_step_sensitivity, rk4_step_sensitivity_from};
+use crate::mechanics::{DynamicsJacobian, MechanicalSystem, Vector, unpack_state};
 use nalgebra::{SMatrix, SVector};
 
 /// How far a joint's speed may move within an interval, in units of its
@@ -28,6 +28,17 @@ where
     /// times `dt`), and the substeps shrink in proportion: the same
     /// stability margin per substep, at least one.
     pub fn interval_substeps(&self, z: &SVector<f64, NX>, u: &Vector<N>) -> usize {
+        if self.config.substeps == 1 || !self.config.substeps_where_stiff {
+            return self.config.substeps;
+        }
+        let (q, qd) = unpack_state::<N, NX>(z);
+        let qdd = self.system.forward_dynamics(&q, &qd, u);
+        self.substeps_at(&qd, &qdd)
+    }
+
+    /// [`Self::interval_substeps`] from the joint speeds and accelerations
+    /// at the interval's start.
+    fn substeps_at(&self, qd: &Vector<N>, qdd: &Vector<N>) -> usize {
         let most = self.config.substeps;
         if most == 1 || !self.config.substeps_where_stiff {
             return most;
@@ -36,8 +47,6 @@ where
         if steepest.is_nan() || steepest <= 0.0 {
             return most;
         }
-        let (q, qd) = unpack_state::<N, NX>(z);
-        let qdd = self.system.forward_dynamics(&q, &qd, u);
         let reach = SPEED_REACH * self.config.dt;
         let slowest = Vector::<N>::from_fn(|j, _| {
             let (lo, hi) = (qd[j] - reach * qdd[j].abs(), qd[j] + reach * qdd[j].abs());
@@ -76,11 +85,23 @@ where
         u: &Vector<N>,
         substeps: usize,
     ) -> (SVector<f64, NX>, SMatrix<f64, NX, NX>, SMatrix<f64, NX, N>) {
+        let (q, qd) = unpack_state::<N, NX>(z);
+        let first = self.system.dynamics_jacobian(&q, &qd, u);
+        self.interval_sensitivity_from(z, u, substeps, &first)
+    }
+
+    /// [`Self::interval_sensitivity`] given the dynamics Jacobian at `z`.
+    fn interval_sensitivity_from(
+        &self,
+        z: &SVector<f64, NX>,
+        u: &Vector<N>,
+        substeps: usize,
+        first: &DynamicsJacobian<N>,
+    ) -> (SVector<f64, NX>, SMatrix<f64, NX, NX>, SMatrix<f64, NX, N>) {
         let h = self.config.dt / substeps as f64;
-        let mut x = *z;
-        let mut a = SMatrix::<f64, NX, NX>::identity();
-        let mut b = SMatrix::<f64, NX, N>::zeros();
-        for _ in 0..substeps {
+        let s = rk4_step_sensitivity_from::<S, N, NX>(&self.system, z, u, h, first);
+        let (mut x, mut a, mut b) = (s.z_next, s.d_z, s.d_tau);
+        for _ in 1..substeps {
             let s = rk4_step_sensitivity::<S, N, NX>(&self.system, &x, u, h);
             x = s.z_next;
             b = s.d_z * b + s.d_tau;
@@ -97,9 +118,14 @@ where
         let q_eq = self.system.equilibrium();
         let mut substeps_taken = 0;
         for k in 0..nh {
-            let substeps = self.interval_substeps(&self.xs[k], &self.us[k]);
+            // The Jacobian at the interval's start is the first RK4 stage's
+            // and its acceleration chooses the substeps: computed once.
+            let (z, u) = (&self.xs[k], &self.us[k]);
+            let (q, qd) = unpack_state::<N, NX>(z);
+            let first = self.system.dynamics_jacobian(&q, &qd, u);
+            let substeps = self.substeps_at(&qd, &first.acceleration);
             substeps_taken += substeps;
-            let (x_next, a, b) = self.interval_sensitivity(&self.xs[k], &self.us[k], substeps);
+            let (x_next, a, b) = self.interval_sensitivity_from(z, u, substeps, &first);
             let m = stage_model::<S, N, NX>(
                 &self.system,
                 &self.reference,
