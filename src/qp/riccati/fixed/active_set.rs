@@ -401,3 +401,73 @@ fn llt_solve<const D: usize, const C: usize>(
     }
     y
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::qp::OcpQp;
+    use crate::qp::riccati::RiccatiSettings;
+    use nalgebra::{DMatrix, DVector};
+
+    /// Two coupled double integrators pushed from far away with bounded
+    /// forces: the controls saturate over the first stages.
+    fn saturating_qp(horizon: usize) -> OcpQp {
+        let mut qp = OcpQp::new(4, 2, horizon);
+        for k in 0..horizon {
+            let wobble = |i: usize, j: usize| 0.02 * ((i + 2 * j + k) as f64).sin();
+            qp.a[k] = DMatrix::from_fn(4, 4, |i, j| match (i, j) {
+                _ if i == j => 1.0,
+                _ if j == i + 2 => 0.1,
+                _ => wobble(i, j),
+            });
+            qp.b[k] = DMatrix::from_fn(4, 2, |i, j| if i == j + 2 { 0.1 } else { 0.0 });
+            qp.c[k] = DVector::from_fn(4, |i, _| 0.001 * i as f64);
+            qp.r[k] = DMatrix::identity(2, 2) * 0.1;
+            qp.s[k] = DMatrix::from_fn(2, 4, |i, j| 0.01 * (i + j) as f64);
+            qp.r_lin[k] = DVector::from_vec(vec![0.01, -0.02]);
+            qp.u_lower[k].fill(-0.5);
+            qp.u_upper[k].fill(0.5);
+        }
+        for k in 0..=horizon {
+            qp.q[k] = DMatrix::identity(4, 4);
+            qp.q_lin[k] = DVector::from_vec(vec![0.0, 0.1, 0.0, -0.1]);
+        }
+        qp.x0 = DVector::from_vec(vec![2.0, -1.5, 0.0, 0.3]);
+        qp
+    }
+
+    #[test]
+    fn an_accepted_guess_has_the_residuals_the_interior_point_would_find() {
+        let horizon = 20;
+        let qp = saturating_qp(horizon);
+        let mut core = FixedCore::<4, 2, 16>::new(horizon);
+        let set = RiccatiSettings {
+            active_set_guesses: 30,
+            ..RiccatiSettings::default()
+        };
+        assert!(core.load(&qp, &set));
+        let mut sol = QpSolution::new(4, 2, horizon);
+        assert_eq!(core.solve_active_set(&mut sol), Some(QpStatus::Solved));
+        let fixed = core.guess[..horizon]
+            .iter()
+            .flat_map(|g| g.guess)
+            .filter(|&b| b != Bound::Free)
+            .count();
+        assert!(fixed >= 4, "the test wants saturated controls: {fixed}");
+        // guess_residuals first: the full pass overwrites `ru`.
+        let own = core.guess_residuals();
+        let full = Core::residuals(&mut core);
+        let round_off = 1e-12 * (1.0 + full.scale);
+        assert!(
+            (own.stationarity - full.stationarity).abs() <= round_off,
+            "{} against {}",
+            own.stationarity,
+            full.stationarity
+        );
+        assert!(own.stationarity <= 1e-9, "{}", own.stationarity);
+        assert!((own.feasibility - full.feasibility).abs() <= 1e-12);
+        assert!((own.scale - full.scale).abs() <= 1e-12 * full.scale);
+        assert_eq!(full.complementarity, 0.0);
+        assert_eq!(sol.dual_residual, own.stationarity);
+    }
+}
