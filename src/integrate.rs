@@ -171,10 +171,7 @@ where
     };
     let (_, qd) = unpack_state::<N, NX>(z);
     let (k1, j1) = (pack_state::<N, NX>(&qd, &first.acceleration), *first);
-    let (dk1_z, dk1_u) = (
-        jacobian_times::<N, NX, NX>(&j1, &eye),
-        torque_column::<N, NX>(&j1),
-    );
+    let (dk1_z, dk1_u) = (state_jacobian_of(&j1), torque_column::<N, NX>(&j1));
 
     let z2 = z + k1 * (0.5 * h);
     let (k2, j2) = stage(&z2);
@@ -211,6 +208,19 @@ fn jacobian_times<const N: usize, const NX: usize, const C: usize>(
     out.fixed_rows_mut::<N>(0).copy_from(&bottom);
     out.fixed_rows_mut::<N>(N)
         .copy_from(&(jac.d_q * top + jac.d_qd * bottom));
+    out
+}
+
+/// `[0 I; Dq Dqd]` itself (its product with the identity, without the
+/// products).
+#[inline(always)]
+fn state_jacobian_of<const N: usize, const NX: usize>(
+    jac: &DynamicsJacobian<N>,
+) -> SMatrix<f64, NX, NX> {
+    let mut out = SMatrix::<f64, NX, NX>::zeros();
+    out.fixed_view_mut::<N, N>(0, N).fill_with_identity();
+    out.fixed_view_mut::<N, N>(N, 0).copy_from(&jac.d_q);
+    out.fixed_view_mut::<N, N>(N, N).copy_from(&jac.d_qd);
     out
 }
 

@@ -20,7 +20,7 @@
 //! `cf atan(k qd)` (`k` = [`PlanarChainParams::coulomb_sharpness`], 100 1/(rad/s)
 //! in the shared parameter files; it tends to `cf pi/2` at speed).
 
-use super::{DynamicsJacobian, Matrix, MechanicalSystem, Vector, sin_cos};
+use super::{DynamicsJacobian, EnergyWithGradient, Matrix, MechanicalSystem, Vector, sin_cos};
 use nalgebra::SMatrix;
 use thiserror::Error;
 
@@ -600,7 +600,7 @@ impl<const N: usize> MechanicalSystem<N> for PlanarChain<N> {
             - self.absolute_centrifugal(&phi, &phid)
             - Vector::<N>::from_fn(|j, _| self.gravity_amplitude[j] * phi[j].sin());
         let phidd = super::solve_spd(&self.absolute_mass_matrix(&phi), &w);
-        Self::l_inverse() * phidd
+        Self::l_inverse_times(&phidd)
     }
 
     fn conservative_dynamics_jacobian(
@@ -609,18 +609,68 @@ impl<const N: usize> MechanicalSystem<N> for PlanarChain<N> {
         qd: &Vector<N>,
         tau: &Vector<N>,
     ) -> DynamicsJacobian<N> {
+        self.jacobian_from(
+            &trigonometry(&Self::absolute(q)),
+            qd,
+            &(tau - self.spring_forces(q)),
+        )
+    }
+
+    fn conservative_dynamics_jacobian_with_energy(
+        &self,
+        q: &Vector<N>,
+        qd: &Vector<N>,
+        tau: &Vector<N>,
+    ) -> (DynamicsJacobian<N>, EnergyWithGradient<N>) {
+        let trig = trigonometry(&Self::absolute(q));
+        let springs = self.spring_forces(q);
+        (
+            self.jacobian_from(&trig, qd, &(tau - springs)),
+            self.energy_from(&trig, q, qd, &springs),
+        )
+    }
+
+    fn energy_gradient(&self, q: &Vector<N>, qd: &Vector<N>) -> (Vector<N>, Vector<N>) {
         let phi = Self::absolute(q);
         let phid = Self::absolute(qd);
+        let a_sin = self.coupling.component_mul(&relative_sin_cos(&phi).0);
+        // dT/dphi_k = -phid_k sum_l a_kl s_kl phid_l
+        let d_kinetic = -phid.component_mul(&(a_sin * phid));
+        let d_e_dq = Self::to_joint_forces(&d_kinetic) + self.potential_gradient(q);
+        let d_e_dqd = self.mass_matrix(q) * qd;
+        (d_e_dq, d_e_dqd)
+    }
+
+    fn energy_with_gradient(&self, q: &Vector<N>, qd: &Vector<N>) -> EnergyWithGradient<N> {
+        let trig = trigonometry(&Self::absolute(q));
+        self.energy_from(&trig, q, qd, &self.spring_forces(q))
+    }
+}
+
+/// The sines and cosines of the absolute angles and of their differences
+/// ([`trigonometry`]), which the dynamics Jacobian and the energy share.
+type Trigonometry<const N: usize> = (Vector<N>, Vector<N>, Matrix<N>, Matrix<N>);
+
+impl<const N: usize> PlanarChain<N> {
+    /// The conservative dynamics Jacobian from the absolute angles'
+    /// trigonometry, at the joint torques net of the springs' `joint`.
+    #[inline]
+    fn jacobian_from(
+        &self,
+        trig: &Trigonometry<N>,
+        qd: &Vector<N>,
+        joint: &Vector<N>,
+    ) -> DynamicsJacobian<N> {
+        let phid = Self::absolute(qd);
         let a = &self.coupling;
-        let (sin_phi, cos_phi, sin, cos) = trigonometry(&phi);
+        let (sin_phi, cos_phi, sin, cos) = *trig;
         let a_cos = a.component_mul(&cos);
         let a_sin = a.component_mul(&sin);
         let mt = a_cos + self.rotor_absolute;
 
-        let joint = tau - self.spring_forces(q);
         let centrifugal = a_sin * phid.component_mul(&phid);
         let gravity = self.gravity_amplitude.component_mul(&sin_phi);
-        let w = Self::to_absolute_forces(&joint) - centrifugal - gravity;
+        let w = Self::to_absolute_forces(joint) - centrifugal - gravity;
 
         // One inverse and four products: cheaper than a Cholesky solve for
         // each of the 3 N + 1 right-hand sides (issue 22), and for two links
@@ -667,25 +717,21 @@ impl<const N: usize> MechanicalSystem<N> for PlanarChain<N> {
         }
     }
 
-    fn energy_gradient(&self, q: &Vector<N>, qd: &Vector<N>) -> (Vector<N>, Vector<N>) {
-        let phi = Self::absolute(q);
-        let phid = Self::absolute(qd);
-        let a_sin = self.coupling.component_mul(&relative_sin_cos(&phi).0);
-        // dT/dphi_k = -phid_k sum_l a_kl s_kl phid_l
-        let d_kinetic = -phid.component_mul(&(a_sin * phid));
-        let d_e_dq = Self::to_joint_forces(&d_kinetic) + self.potential_gradient(q);
-        let d_e_dqd = self.mass_matrix(q) * qd;
-        (d_e_dq, d_e_dqd)
-    }
-
-    fn energy_with_gradient(&self, q: &Vector<N>, qd: &Vector<N>) -> (f64, Vector<N>, Vector<N>) {
+    /// The energy with its gradient from the absolute angles'
+    /// trigonometry and the springs' torques.
+    #[inline]
+    fn energy_from(
+        &self,
+        trig: &Trigonometry<N>,
+        q: &Vector<N>,
+        qd: &Vector<N>,
+        springs: &Vector<N>,
+    ) -> EnergyWithGradient<N> {
         // In absolute angles, `qd' M qd = phid' Mt phid` (`M = L' Mt L`),
         // from one set of sines and cosines.
-        let phi = Self::absolute(q);
         let phid = Self::absolute(qd);
-        let (sin_phi, cos_phi, sin, cos) = trigonometry(&phi);
+        let (sin_phi, cos_phi, sin, cos) = *trig;
         let momentum = (self.coupling.component_mul(&cos) + self.rotor_absolute) * phid;
-        let springs = self.spring_forces(q);
         let mut energy = 0.5 * phid.dot(&momentum) - self.potential_offset;
         for j in 0..N {
             let d = q[j] - self.params.joints[j].rest_angle;
@@ -731,7 +777,7 @@ fn spd_inverse<const N: usize>(m: &Matrix<N>) -> Option<Matrix<N>> {
 /// calls were 12 % of an RTI sample on the orbit (issue 12); the pairs are
 /// [`sin_cos`]'s (about half of libm's instructions).
 #[inline]
-fn trigonometry<const N: usize>(phi: &Vector<N>) -> (Vector<N>, Vector<N>, Matrix<N>, Matrix<N>) {
+fn trigonometry<const N: usize>(phi: &Vector<N>) -> Trigonometry<N> {
     let mut sin_phi = Vector::<N>::zeros();
     let mut cos_phi = Vector::<N>::zeros();
     for j in 0..N {
@@ -798,6 +844,35 @@ mod tests {
                 assert!((sin[(j, l)] - (phi[j] - phi[l]).sin()).abs() < 4.0 * f64::EPSILON);
                 assert!((cos[(j, l)] - (phi[j] - phi[l]).cos()).abs() < 4.0 * f64::EPSILON);
             }
+        }
+    }
+
+    /// The shared-trigonometry path gives exactly what the two separate
+    /// calls give, with motors, springs and friction on every joint.
+    #[test]
+    fn jacobian_with_energy_is_the_jacobian_and_the_energy() {
+        let mut p = PlanarChainParams::<3>::point_masses([1.3, 0.7, 0.4], [0.9, 1.2, 0.6], 9.81);
+        for (j, joint) in p.joints.iter_mut().enumerate() {
+            let f = (j + 1) as f64;
+            joint.rotor_inertia = 1e-5 * f;
+            joint.gear_ratio = 20.0 * f;
+            joint.viscous = 0.02 * f;
+            joint.coulomb = 0.05 * f;
+            joint.stiffness = 0.8 * f;
+            joint.rest_angle = 0.1 * f;
+        }
+        let chain = PlanarChain::<3>::new(p).unwrap();
+        for (q, qd) in [
+            ([0.3, -1.7, 2.9], [0.4, -0.2, 1.1]),
+            ([-2.5, 0.01, -0.6], [0.0, 3.0, -0.004]),
+        ] {
+            let (q, qd) = (Vector::<3>::from(q), Vector::<3>::from(qd));
+            let tau = Vector::<3>::new(0.2, -0.1, 0.05);
+            let (jac, energy) = chain.dynamics_jacobian_with_energy(&q, &qd, &tau);
+            assert_eq!(jac, chain.dynamics_jacobian(&q, &qd, &tau));
+            assert_eq!(energy, chain.energy_with_gradient(&q, &qd));
+            // And the energy is the energy (the springs included once).
+            assert!((energy.0 - chain.energy(&q, &qd)).abs() < 1e-12);
         }
     }
 

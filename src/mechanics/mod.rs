@@ -23,6 +23,9 @@ pub type Vector<const N: usize> = SVector<f64, N>;
 /// Square configuration-space matrix (inertia, stiffness, Jacobian blocks).
 pub type Matrix<const N: usize> = SMatrix<f64, N, N>;
 
+/// The energy with its exact gradient, `(E, dE/dq, dE/dqd)`.
+pub type EnergyWithGradient<const N: usize> = (f64, Vector<N>, Vector<N>);
+
 /// Forward dynamics and its exact first derivatives at one point.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DynamicsJacobian<const N: usize> {
@@ -73,7 +76,7 @@ pub trait MechanicalSystem<const N: usize> {
     /// [`energy`](Self::energy) and [`energy_gradient`](Self::energy_gradient)
     /// give them. The cost evaluates both at every stage: an implementor
     /// shares their trigonometry here.
-    fn energy_with_gradient(&self, q: &Vector<N>, qd: &Vector<N>) -> (f64, Vector<N>, Vector<N>) {
+    fn energy_with_gradient(&self, q: &Vector<N>, qd: &Vector<N>) -> EnergyWithGradient<N> {
         let (d_q, d_qd) = self.energy_gradient(q, qd);
         (self.energy(q, qd), d_q, d_qd)
     }
@@ -121,6 +124,44 @@ pub trait MechanicalSystem<const N: usize> {
         tau: &Vector<N>,
     ) -> DynamicsJacobian<N> {
         let mut jac = self.conservative_dynamics_jacobian(q, qd, &(tau - self.friction(qd)));
+        self.add_friction_slope(&mut jac, qd);
+        jac
+    }
+
+    /// [`dynamics_jacobian`](Self::dynamics_jacobian) and
+    /// [`energy_with_gradient`](Self::energy_with_gradient) at one state,
+    /// exactly as they give them: the linearisation needs both at every
+    /// shooting node.
+    fn dynamics_jacobian_with_energy(
+        &self,
+        q: &Vector<N>,
+        qd: &Vector<N>,
+        tau: &Vector<N>,
+    ) -> (DynamicsJacobian<N>, EnergyWithGradient<N>) {
+        let (mut jac, energy) =
+            self.conservative_dynamics_jacobian_with_energy(q, qd, &(tau - self.friction(qd)));
+        self.add_friction_slope(&mut jac, qd);
+        (jac, energy)
+    }
+
+    /// [`conservative_dynamics_jacobian`](Self::conservative_dynamics_jacobian)
+    /// and [`energy_with_gradient`](Self::energy_with_gradient) at one
+    /// state: an implementor shares their trigonometry here.
+    fn conservative_dynamics_jacobian_with_energy(
+        &self,
+        q: &Vector<N>,
+        qd: &Vector<N>,
+        tau: &Vector<N>,
+    ) -> (DynamicsJacobian<N>, EnergyWithGradient<N>) {
+        (
+            self.conservative_dynamics_jacobian(q, qd, tau),
+            self.energy_with_gradient(q, qd),
+        )
+    }
+
+    /// Friction's speed derivative folded into a conservative Jacobian
+    /// (taken at `tau - tau_f(qd)`): `d_qd -= d_tau diag(tau_f')`.
+    fn add_friction_slope(&self, jac: &mut DynamicsJacobian<N>, qd: &Vector<N>) {
         let slope = self.friction_slope(qd);
         for j in 0..N {
             if slope[j] != 0.0 {
@@ -129,7 +170,6 @@ pub trait MechanicalSystem<const N: usize> {
                 d -= column;
             }
         }
-        jac
     }
 
     /// Kinetic energy `1/2 qd' M(q) qd`.
@@ -181,8 +221,17 @@ where
     fn energy_gradient(&self, q: &Vector<N>, qd: &Vector<N>) -> (Vector<N>, Vector<N>) {
         self.0.energy_gradient(q, qd)
     }
-    fn energy_with_gradient(&self, q: &Vector<N>, qd: &Vector<N>) -> (f64, Vector<N>, Vector<N>) {
+    fn energy_with_gradient(&self, q: &Vector<N>, qd: &Vector<N>) -> EnergyWithGradient<N> {
         self.0.energy_with_gradient(q, qd)
+    }
+    fn conservative_dynamics_jacobian_with_energy(
+        &self,
+        q: &Vector<N>,
+        qd: &Vector<N>,
+        tau: &Vector<N>,
+    ) -> (DynamicsJacobian<N>, EnergyWithGradient<N>) {
+        self.0
+            .conservative_dynamics_jacobian_with_energy(q, qd, tau)
     }
     fn conservative_forward_dynamics(
         &self,

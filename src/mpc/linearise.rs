@@ -2,7 +2,7 @@
 //! exact sensitivities, and the QP in the step variables at the current plan.
 
 use super::Controller;
-use super::cost::stage_model;
+use super::cost::{stage_model, stage_model_at};
 use crate::integrate::{rk4_step_sensitivity, rk4_step_sensitivity_from};
 use crate::mechanics::{DynamicsJacobian, MechanicalSystem, Vector, unpack_state};
 use nalgebra::{SMatrix, SVector};
@@ -28,21 +28,29 @@ where
     /// times `dt`), and the substeps shrink in proportion: the same
     /// stability margin per substep, at least one.
     pub fn interval_substeps(&self, z: &SVector<f64, NX>, u: &Vector<N>) -> usize {
-        if self.config.substeps == 1 || !self.config.substeps_where_stiff {
-            return self.config.substeps;
+        if let Some(every) = self.substeps_everywhere() {
+            // Skips the forward dynamics.
+            return every;
         }
         let (q, qd) = unpack_state::<N, NX>(z);
         let qdd = self.system.forward_dynamics(&q, &qd, u);
         self.substeps_at(&qd, &qdd)
     }
 
+    /// The substeps of every interval when they do not depend on the
+    /// state: one, or all of them without `substeps_where_stiff`.
+    fn substeps_everywhere(&self) -> Option<usize> {
+        let most = self.config.substeps;
+        (most == 1 || !self.config.substeps_where_stiff).then_some(most)
+    }
+
     /// [`Self::interval_substeps`] from the joint speeds and accelerations
     /// at the interval's start.
     fn substeps_at(&self, qd: &Vector<N>, qdd: &Vector<N>) -> usize {
-        let most = self.config.substeps;
-        if most == 1 || !self.config.substeps_where_stiff {
-            return most;
+        if let Some(every) = self.substeps_everywhere() {
+            return every;
         }
+        let most = self.config.substeps;
         let steepest = self.system.friction_slope(&Vector::zeros()).max();
         if steepest.is_nan() || steepest <= 0.0 {
             return most;
@@ -122,18 +130,13 @@ where
             // and its acceleration chooses the substeps: computed once.
             let (z, u) = (&self.xs[k], &self.us[k]);
             let (q, qd) = unpack_state::<N, NX>(z);
-            let first = self.system.dynamics_jacobian(&q, &qd, u);
+            // The node's energy shares the Jacobian's trigonometry.
+            let (first, energy) = self.system.dynamics_jacobian_with_energy(&q, &qd, u);
             let substeps = self.substeps_at(&qd, &first.acceleration);
             substeps_taken += substeps;
             let (x_next, a, b) = self.interval_sensitivity_from(z, u, substeps, &first);
-            let m = stage_model::<S, N, NX>(
-                &self.system,
-                &self.reference,
-                &cost,
-                &self.xs[k],
-                &self.us[k],
-                dt,
-            );
+            let m =
+                stage_model_at::<S, N, NX>(&self.system, &self.reference, &cost, z, u, dt, &energy);
             self.qp.a[k].copy_from(&a);
             self.qp.b[k].copy_from(&b);
             self.qp.c[k].copy_from(&(x_next - self.xs[k + 1]));

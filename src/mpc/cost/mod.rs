@@ -19,7 +19,7 @@ mod variant;
 pub use reference::{Guide, Reference, ReferenceError};
 pub use variant::{CostVariant, StagePoint, VariantInfo};
 
-use crate::mechanics::{Matrix, MechanicalSystem, Vector, unpack_state};
+use crate::mechanics::{EnergyWithGradient, Matrix, MechanicalSystem, Vector, unpack_state};
 use nalgebra::{SMatrix, SVector};
 use variant::cost_variant_table;
 
@@ -161,7 +161,25 @@ where
     S: MechanicalSystem<N> + ?Sized,
 {
     let (q, qd) = unpack_state::<N, NX>(z);
-    let (energy, de_dq, de_dqd) = system.energy_with_gradient(&q, &qd);
+    let energy = system.energy_with_gradient(&q, &qd);
+    residuals_at(system, reference, params, z, tau, &energy)
+}
+
+/// [`residuals`] given the energy with its gradient at `z` (inlined: the
+/// residuals are a large value to return).
+#[inline(always)]
+fn residuals_at<S, const N: usize, const NX: usize>(
+    system: &S,
+    reference: &Reference<N>,
+    params: &CostParams,
+    z: &SVector<f64, NX>,
+    tau: &Vector<N>,
+    &(energy, de_dq, de_dqd): &EnergyWithGradient<N>,
+) -> Residuals<N, NX>
+where
+    S: MechanicalSystem<N> + ?Sized,
+{
+    let (q, qd) = unpack_state::<N, NX>(z);
     let mut grad_e = SVector::<f64, NX>::zeros();
     grad_e.fixed_rows_mut::<N>(0).copy_from(&de_dq);
     grad_e.fixed_rows_mut::<N>(N).copy_from(&de_dqd);
@@ -239,7 +257,26 @@ pub fn stage_model<S, const N: usize, const NX: usize>(
 where
     S: MechanicalSystem<N> + ?Sized,
 {
-    let r = residuals::<S, N, NX>(system, reference, params, z, tau);
+    let (q, qd) = unpack_state::<N, NX>(z);
+    let energy = system.energy_with_gradient(&q, &qd);
+    stage_model_at(system, reference, params, z, tau, scale, &energy)
+}
+
+/// [`stage_model`] given the energy with its gradient at `z` (the
+/// linearisation has it from the dynamics Jacobian's trigonometry).
+pub(crate) fn stage_model_at<S, const N: usize, const NX: usize>(
+    system: &S,
+    reference: &Reference<N>,
+    params: &CostParams,
+    z: &SVector<f64, NX>,
+    tau: &Vector<N>,
+    scale: f64,
+    energy: &EnergyWithGradient<N>,
+) -> StageModel<N, NX>
+where
+    S: MechanicalSystem<N> + ?Sized,
+{
+    let r = residuals_at::<S, N, NX>(system, reference, params, z, tau, energy);
     let w = &params.weights;
     let two = 2.0 * scale;
     let q = (r.energy_z * r.energy_z.transpose()) * w.energy

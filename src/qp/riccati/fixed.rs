@@ -443,6 +443,17 @@ fn nan_probe(v: f64) -> f64 {
 /// entry. Not finite entries are left to the NaN probe.
 #[inline(always)]
 fn symmetric<const D: usize>(m: &Mat<D, D>) -> bool {
+    // The common case first: an exactly symmetric block (a Gauss-Newton
+    // `J' W J` is), one comparison a pair and no scale.
+    let mut exact = true;
+    for j in 0..D {
+        for i in j + 1..D {
+            exact &= m[(i, j)] == m[(j, i)];
+        }
+    }
+    if exact {
+        return true;
+    }
     let (mut scale, mut asym) = (0.0f64, 0.0f64);
     for j in 0..D {
         for i in 0..D {
