@@ -124,7 +124,7 @@ pub trait MechanicalSystem<const N: usize> {
         tau: &Vector<N>,
     ) -> DynamicsJacobian<N> {
         let mut jac = self.conservative_dynamics_jacobian(q, qd, &(tau - self.friction(qd)));
-        self.add_friction_slope(&mut jac, qd);
+        add_friction_slope(&mut jac, &self.friction_slope(qd));
         jac
     }
 
@@ -140,7 +140,7 @@ pub trait MechanicalSystem<const N: usize> {
     ) -> (DynamicsJacobian<N>, EnergyWithGradient<N>) {
         let (mut jac, energy) =
             self.conservative_dynamics_jacobian_with_energy(q, qd, &(tau - self.friction(qd)));
-        self.add_friction_slope(&mut jac, qd);
+        add_friction_slope(&mut jac, &self.friction_slope(qd));
         (jac, energy)
     }
 
@@ -159,19 +159,6 @@ pub trait MechanicalSystem<const N: usize> {
         )
     }
 
-    /// Friction's speed derivative folded into a conservative Jacobian
-    /// (taken at `tau - tau_f(qd)`): `d_qd -= d_tau diag(tau_f')`.
-    fn add_friction_slope(&self, jac: &mut DynamicsJacobian<N>, qd: &Vector<N>) {
-        let slope = self.friction_slope(qd);
-        for j in 0..N {
-            if slope[j] != 0.0 {
-                let column = jac.d_tau.column(j) * slope[j];
-                let mut d = jac.d_qd.column_mut(j);
-                d -= column;
-            }
-        }
-    }
-
     /// Kinetic energy `1/2 qd' M(q) qd`.
     fn kinetic_energy(&self, q: &Vector<N>, qd: &Vector<N>) -> f64 {
         0.5 * qd.dot(&(self.mass_matrix(q) * qd))
@@ -180,6 +167,18 @@ pub trait MechanicalSystem<const N: usize> {
     /// Total energy `E = 1/2 qd' M(q) qd + V(q)` (paper, eq. 3).
     fn energy(&self, q: &Vector<N>, qd: &Vector<N>) -> f64 {
         self.kinetic_energy(q, qd) + self.potential(q)
+    }
+}
+
+/// Friction's speed derivative folded into a conservative Jacobian (taken
+/// at `tau - tau_f(qd)`): `d_qd -= d_tau diag(slope)`, `slope = tau_f'(qd)`.
+fn add_friction_slope<const N: usize>(jac: &mut DynamicsJacobian<N>, slope: &Vector<N>) {
+    for j in 0..N {
+        if slope[j] != 0.0 {
+            let column = jac.d_tau.column(j) * slope[j];
+            let mut d = jac.d_qd.column_mut(j);
+            d -= column;
+        }
     }
 }
 
