@@ -172,6 +172,7 @@ pub trait MechanicalSystem<const N: usize> {
 
 /// Friction's speed derivative folded into a conservative Jacobian (taken
 /// at `tau - tau_f(qd)`): `d_qd -= d_tau diag(slope)`, `slope = tau_f'(qd)`.
+#[inline(always)]
 fn add_friction_slope<const N: usize>(jac: &mut DynamicsJacobian<N>, slope: &Vector<N>) {
     for j in 0..N {
         if slope[j] != 0.0 {
