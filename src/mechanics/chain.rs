@@ -483,11 +483,6 @@ impl<const N: usize> PlanarChain<N> {
         out
     }
 
-    /// Inertia in absolute angles `Mt(phi)`, rotors included.
-    fn absolute_mass_matrix(&self, phi: &Vector<N>) -> Matrix<N> {
-        self.coupling.component_mul(&relative_sin_cos(phi).1) + self.rotor_absolute
-    }
-
     /// Centrifugal forces in absolute angles `h_j = sum_l a_jl sin(phi_j - phi_l) phid_l^2`.
     fn absolute_centrifugal(&self, phi: &Vector<N>, phid: &Vector<N>) -> Vector<N> {
         Vector::<N>::from_fn(|j, _| {
@@ -591,15 +586,12 @@ impl<const N: usize> MechanicalSystem<N> for PlanarChain<N> {
         qd: &Vector<N>,
         tau: &Vector<N>,
     ) -> Vector<N> {
-        // Solve in absolute angles, Mt phidd = L^-T (tau - K (q - q_rest)) - h - G,
-        // which avoids forming L' Mt L.
-        let phi = Self::absolute(q);
+        // Solved in absolute angles, Mt phidd = L^-T (tau - K (q - q_rest)) - h - G,
+        // which avoids forming L' Mt L; the same arithmetic as the
+        // Jacobian's acceleration, so both give the same bits.
+        let trig = trigonometry(&Self::absolute(q));
         let phid = Self::absolute(qd);
-        let joint = tau - self.spring_forces(q);
-        let w = Self::to_absolute_forces(&joint)
-            - self.absolute_centrifugal(&phi, &phid)
-            - Vector::<N>::from_fn(|j, _| self.gravity_amplitude[j] * phi[j].sin());
-        let phidd = super::solve_spd(&self.absolute_mass_matrix(&phi), &w);
+        let (phidd, _) = self.absolute_acceleration(&trig, &phid, &(tau - self.spring_forces(q)));
         Self::l_inverse_times(&phidd)
     }
 
@@ -654,7 +646,7 @@ type Trigonometry<const N: usize> = (Vector<N>, Vector<N>, Matrix<N>, Matrix<N>)
 impl<const N: usize> PlanarChain<N> {
     /// The conservative dynamics Jacobian from the absolute angles'
     /// trigonometry, at the joint torques net of the springs' `joint`.
-    #[inline]
+    #[inline(always)]
     fn jacobian_from(
         &self,
         trig: &Trigonometry<N>,
@@ -662,26 +654,37 @@ impl<const N: usize> PlanarChain<N> {
         joint: &Vector<N>,
     ) -> DynamicsJacobian<N> {
         let phid = Self::absolute(qd);
-        let a = &self.coupling;
-        let (sin_phi, cos_phi, sin, cos) = *trig;
-        let a_cos = a.component_mul(&cos);
-        let a_sin = a.component_mul(&sin);
-        let mt = a_cos + self.rotor_absolute;
-
-        let centrifugal = a_sin * phid.component_mul(&phid);
-        let gravity = self.gravity_amplitude.component_mul(&sin_phi);
-        let w = Self::to_absolute_forces(joint) - centrifugal - gravity;
-
-        // One inverse and four products: cheaper than a Cholesky solve for
-        // each of the 3 N + 1 right-hand sides (issue 22), and for two links
-        // the inverse is closed-form.
-        let mt_inv = spd_inverse(&mt).unwrap_or(Matrix::<N>::repeat(f64::NAN));
-        let phidd = mt_inv * w;
+        let (phidd, mt_inv) = self.absolute_acceleration(trig, &phid, joint);
+        let (dw_dq, dw_dqd) = if N == 2 {
+            self.two_link_force_derivatives(trig, &phid, &phidd)
+        } else {
+            self.force_derivatives(trig, &phid, &phidd)
+        };
         // L, L^-1 and L^-T are sums and differences of neighbours: applied
         // as such, not as dense products (a third of the arithmetic here).
         let response = Self::l_inverse_times(&mt_inv);
+        DynamicsJacobian {
+            acceleration: Self::l_inverse_times(&phidd),
+            d_q: response * dw_dq,
+            d_qd: response * dw_dqd,
+            d_tau: Self::times_l_inverse_t(&response),
+        }
+    }
 
-        let phid_sq = phid.component_mul(&phid);
+    /// The derivatives of the absolute-angle balance `w - Mt phidd` with
+    /// respect to the joint angles and speeds, at the accelerations
+    /// `phidd`: `Mt^-1` times them, in joint terms, is the Jacobian.
+    #[inline(always)]
+    fn force_derivatives(
+        &self,
+        trig: &Trigonometry<N>,
+        phid: &Vector<N>,
+        phidd: &Vector<N>,
+    ) -> (Matrix<N>, Matrix<N>) {
+        let (_, cos_phi, sin, cos) = *trig;
+        let a_cos = self.coupling.component_mul(&cos);
+        let a_sin = self.coupling.component_mul(&sin);
+        let phid_sq = phid.component_mul(phid);
         // d(Mt phidd)/d phi: -diag(sum_l a_jl s_jl phidd_l) + a_jk s_jk phidd_k
         // (the rotor inertia is constant and drops out).
         let row_mass = a_sin * phidd;
@@ -707,14 +710,79 @@ impl<const N: usize> PlanarChain<N> {
                 dw_dq[(j, j + 1)] += springs[j + 1];
             }
         }
-        let dw_dqd = -Self::times_l(&d_cent_phid);
+        (dw_dq, -Self::times_l(&d_cent_phid))
+    }
 
-        DynamicsJacobian {
-            acceleration: Self::l_inverse_times(&phidd),
-            d_q: response * dw_dq,
-            d_qd: response * dw_dqd,
-            d_tau: Self::times_l_inverse_t(&response),
-        }
+    /// [`Self::force_derivatives`] for two links, written out: the same
+    /// formulas without the products with the zeros and ones of the
+    /// relative angle's sines and cosines on the diagonal (a sample of the
+    /// paper pendulum evaluates them 400 times).
+    #[inline(always)]
+    fn two_link_force_derivatives(
+        &self,
+        trig: &Trigonometry<N>,
+        phid: &Vector<N>,
+        phidd: &Vector<N>,
+    ) -> (Matrix<N>, Matrix<N>) {
+        let (_, cos_phi, sin, cos) = trig;
+        let (s, c) = (sin[(0, 1)], cos[(0, 1)]);
+        let a = &self.coupling;
+        let (a01, a10) = (a[(0, 1)], a[(1, 0)]);
+        let (p0, p1) = (phid[0], phid[1]);
+        let (dd0, dd1) = (phidd[0], phidd[1]);
+        let (sq0, sq1) = (p0 * p0, p1 * p1);
+        // The generic form's d_mass, d_cent_phi and d_grav: the relative
+        // angle's terms appear in pairs of opposite sign in each row
+        // (a_sin = [0 a01 s; -a10 s 0]).
+        let mass01 = a01 * s * dd1;
+        let mass10 = -(a10 * s) * dd0;
+        let cent01 = a01 * c * sq1;
+        let cent10 = a10 * c * sq0;
+        let g0 = self.gravity_amplitude[0] * cos_phi[0];
+        let g1 = self.gravity_amplitude[1] * cos_phi[1];
+        // -(d_cent_phi + d_grav + d_mass) in absolute angles, then times L
+        // (column 0 is the sum of both columns) and the springs.
+        let m00 = -(cent01 + g0 - mass01);
+        let m01 = cent01 - mass01;
+        let m10 = cent10 - mass10;
+        let m11 = -(cent10 + g1 - mass10);
+        let springs = self.stiffness();
+        let dw_dq = Matrix::<N>::from_fn(|j, k| match (j, k) {
+            (0, 0) => m00 + m01 - springs[0],
+            (0, _) => m01 + springs[1],
+            (_, 0) => m10 + m11,
+            _ => m11 - springs[1],
+        });
+        // -(dh/d phid) L: dh_0/d phid_1 = 2 a01 s p1, dh_1/d phid_0 = -2 a10 s p0.
+        let (h01, h10) = (2.0 * a01 * s * p1, -2.0 * a10 * s * p0);
+        let dw_dqd = Matrix::<N>::from_fn(|j, k| match (j, k) {
+            (0, _) => -h01,
+            (_, 0) => -h10,
+            _ => 0.0,
+        });
+        (dw_dq, dw_dqd)
+    }
+
+    /// The absolute angles' accelerations `phidd = Mt^-1 w` and `Mt^-1`,
+    /// from the angles' trigonometry, the absolute speeds `phid` and the
+    /// joint torques net of the springs' `joint`.
+    #[inline(always)]
+    fn absolute_acceleration(
+        &self,
+        trig: &Trigonometry<N>,
+        phid: &Vector<N>,
+        joint: &Vector<N>,
+    ) -> (Vector<N>, Matrix<N>) {
+        let (sin_phi, _, sin, cos) = trig;
+        let mt = self.coupling.component_mul(cos) + self.rotor_absolute;
+        let centrifugal = self.coupling.component_mul(sin) * phid.component_mul(phid);
+        let gravity = self.gravity_amplitude.component_mul(sin_phi);
+        let w = Self::to_absolute_forces(joint) - centrifugal - gravity;
+        // One inverse and four products: cheaper than a Cholesky solve for
+        // each of the 3 N + 1 right-hand sides of the Jacobian (issue 22),
+        // and for two links the inverse is closed-form.
+        let mt_inv = spd_inverse(&mt).unwrap_or(Matrix::<N>::repeat(f64::NAN));
+        (mt_inv * w, mt_inv)
     }
 
     /// The energy with its gradient from the absolute angles'
@@ -776,7 +844,7 @@ fn spd_inverse<const N: usize>(m: &Matrix<N>) -> Option<Matrix<N>> {
 /// the difference formulas (to a few ulps of the direct values). The libm
 /// calls were 12 % of an RTI sample on the orbit (issue 12); the pairs are
 /// [`sin_cos`]'s (about half of libm's instructions).
-#[inline]
+#[inline(always)]
 fn trigonometry<const N: usize>(phi: &Vector<N>) -> Trigonometry<N> {
     let mut sin_phi = Vector::<N>::zeros();
     let mut cos_phi = Vector::<N>::zeros();
@@ -847,11 +915,9 @@ mod tests {
         }
     }
 
-    /// The shared-trigonometry path gives exactly what the two separate
-    /// calls give, with motors, springs and friction on every joint.
-    #[test]
-    fn jacobian_with_energy_is_the_jacobian_and_the_energy() {
-        let mut p = PlanarChainParams::<3>::point_masses([1.3, 0.7, 0.4], [0.9, 1.2, 0.6], 9.81);
+    /// The chain of `p` with a motor, a spring, viscous and Coulomb
+    /// friction on every joint, each joint's different.
+    fn with_every_joint_term<const N: usize>(mut p: PlanarChainParams<N>) -> PlanarChain<N> {
         for (j, joint) in p.joints.iter_mut().enumerate() {
             let f = (j + 1) as f64;
             joint.rotor_inertia = 1e-5 * f;
@@ -861,7 +927,15 @@ mod tests {
             joint.stiffness = 0.8 * f;
             joint.rest_angle = 0.1 * f;
         }
-        let chain = PlanarChain::<3>::new(p).unwrap();
+        PlanarChain::new(p).unwrap()
+    }
+
+    /// The shared-trigonometry path gives exactly what the two separate
+    /// calls give, with motors, springs and friction on every joint.
+    #[test]
+    fn jacobian_with_energy_is_the_jacobian_and_the_energy() {
+        let p = PlanarChainParams::<3>::point_masses([1.3, 0.7, 0.4], [0.9, 1.2, 0.6], 9.81);
+        let chain = with_every_joint_term(p);
         for (q, qd) in [
             ([0.3, -1.7, 2.9], [0.4, -0.2, 1.1]),
             ([-2.5, 0.01, -0.6], [0.0, 3.0, -0.004]),
@@ -873,6 +947,58 @@ mod tests {
             assert_eq!(energy, chain.energy_with_gradient(&q, &qd));
             // And the energy is the energy (the springs included once).
             assert!((energy.0 - chain.energy(&q, &qd)).abs() < 1e-12);
+        }
+    }
+
+    /// The two-link Jacobian written out equals the generic one to
+    /// rounding, on a chain with rigid links, motors, springs and friction
+    /// (the laboratory robots' kind), and both match finite differences.
+    #[test]
+    fn two_link_jacobian_is_the_generic_one() {
+        let mut p = PlanarChainParams::<2>::point_masses([1.3, 0.7], [0.9, 1.2], 9.81);
+        p.links[0] = Link::with_inertia_about_joint(0.8, 0.25, 0.11, 0.021);
+        p.links[1] = Link::with_inertia_about_joint(0.4, 0.3, 0.17, 0.019);
+        let chain = with_every_joint_term(p);
+        for (q, qd, tau) in [
+            ([0.3, -1.7], [0.4, -0.2], [0.2, -0.1]),
+            ([-2.5, 0.01], [0.0, 3.0], [-0.3, 0.05]),
+            ([3.1, 2.9], [-7.0, 11.0], [0.0, 0.0]),
+        ] {
+            let (q, qd, tau) = (
+                Vector::<2>::from(q),
+                Vector::<2>::from(qd),
+                Vector::<2>::from(tau),
+            );
+            let joint = tau - chain.friction(&qd) - chain.spring_forces(&q);
+            let trig = trigonometry(&PlanarChain::<2>::absolute(&q));
+            let phid = PlanarChain::<2>::absolute(&qd);
+            let (phidd, _) = chain.absolute_acceleration(&trig, &phid, &joint);
+            let two = chain.two_link_force_derivatives(&trig, &phid, &phidd);
+            let any = chain.force_derivatives(&trig, &phid, &phidd);
+            let close = |a: &Matrix<2>, b: &Matrix<2>| (a - b).amax() <= 1e-12 * (1.0 + b.amax());
+            assert!(close(&two.0, &any.0), "{} {}", two.0, any.0);
+            assert!(close(&two.1, &any.1), "{} {}", two.1, any.1);
+            // The forward dynamics gives the Jacobian's acceleration, and
+            // central differences of it give the Jacobian.
+            let full = chain.dynamics_jacobian(&q, &qd, &tau);
+            assert_eq!(full.acceleration, chain.forward_dynamics(&q, &qd, &tau));
+            let eps = 1e-6;
+            for i in 0..2 {
+                let e = Vector::<2>::from_fn(|j, _| if i == j { eps } else { 0.0 });
+                let fd_q = (chain.forward_dynamics(&(q + e), &qd, &tau)
+                    - chain.forward_dynamics(&(q - e), &qd, &tau))
+                    / (2.0 * eps);
+                let fd_qd = (chain.forward_dynamics(&q, &(qd + e), &tau)
+                    - chain.forward_dynamics(&q, &(qd - e), &tau))
+                    / (2.0 * eps);
+                let fd_tau = (chain.forward_dynamics(&q, &qd, &(tau + e))
+                    - chain.forward_dynamics(&q, &qd, &(tau - e)))
+                    / (2.0 * eps);
+                for (fd, exact) in [(fd_q, full.d_q), (fd_qd, full.d_qd), (fd_tau, full.d_tau)] {
+                    let col = exact.column(i).into_owned();
+                    assert!((fd - col).amax() <= 1e-6 * (1.0 + col.amax()), "{fd} {col}");
+                }
+            }
         }
     }
 
