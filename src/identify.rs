@@ -304,7 +304,7 @@ pub fn friction_features<const N: usize, const NP: usize>(
     let mut f = SVector::<f64, NP>::zeros();
     for j in 0..N {
         f[B::<N, NP>::viscous_index(j)] = qd[j] * qd[j];
-        f[B::<N, NP>::coulomb_index(j)] = qd[j] * (params.coulomb_sharpness * qd[j]).atan();
+        f[B::<N, NP>::coulomb_index(j)] = qd[j] * libm::atan(params.coulomb_sharpness * qd[j]);
     }
     f
 }
