@@ -22,7 +22,7 @@ fn record(variant: Variant, seconds: f64) -> Vec<OcpQp> {
     let z0 = SVector::<f64, 4>::new(0.05, 0.05, 0.0, 0.0);
     let duration = seconds - config.dt;
     run_with(&mut ctrl, &sys, &z0, duration, |_, ctrl, _| {
-        qps.push(ctrl.last_qp().0.clone())
+        qps.push(ctrl.last_qp().0)
     })
     .unwrap();
     qps

@@ -232,7 +232,7 @@ fn clarabel_qp_solutions_satisfy_kkt() {
                     zz[2] += 0.1;
                 }
                 let (qp, sol) = ctrl.last_qp();
-                let kkt = kkt_residuals(qp, sol);
+                let kkt = kkt_residuals(&qp, sol);
                 let (stat, prim, bound, comp) = (
                     kkt.stationarity,
                     kkt.primal_feasibility,
@@ -275,7 +275,7 @@ fn rti_iterations_converge_to_the_sqp_solution_on_the_first_sample() {
         let (qp, sol) = sqp.last_qp();
         let step: f64 = sol.u.iter().map(|u| u.amax()).fold(0.0, f64::max);
         assert!(step < 1e-10, "{variant}: last SQP step {step:e}");
-        assert!(kkt_residuals(qp, sol).max() < 1e-8);
+        assert!(kkt_residuals(&qp, sol).max() < 1e-8);
 
         let mut rti_config = config;
         rti_config.startup = Startup::Iterations(1);

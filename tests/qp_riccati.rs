@@ -8,7 +8,7 @@ use common::qp_reference::{Reference, clarabel_solve, dense_kkt_solve};
 use eigenmpc::qp::record::{QpRecordReader, QpRecordWriter};
 use eigenmpc::qp::synthetic::{PendulumQpOptions, SplitMix64, pendulum_rti_qp, random_ocp_qp};
 use eigenmpc::qp::{
-    OcpQp, QpSolution, QpSolver, QpStatus, RiccatiSettings, RiccatiSolver, kkt_residuals,
+    OcpQp, QpSolution, QpSolver, QpStatus, RiccatiSettings, RiccatiSolver, StageQp, kkt_residuals,
 };
 use std::path::{Path, PathBuf};
 
@@ -673,4 +673,95 @@ fn active_set_start_gives_up_after_its_guesses() {
     assert_eq!(solver.solve(&next, &mut sol), QpStatus::Solved);
     assert!(solver.info().active_set_start, "{:?}", solver.info());
     assert_matches("the next sample", &next, &sol, &clarabel_solve(&next));
+}
+
+/// [`QpSolver::solve_stages`] on the stage-wise form against
+/// [`QpSolver::solve`] on the same QP: a sequence of shifted, perturbed
+/// QPs with saturated controls and warm starts, both solvers fed the same.
+fn stage_wise_matches<const NX: usize, const NU: usize>(rng: &mut SplitMix64) {
+    let n = 40;
+    let mut qp = with_control_box(random_ocp_qp(rng, NX, NU, n), 0.3);
+    let settings = RiccatiSettings::default();
+    let mut by_ocp = RiccatiSolver::new(NX, NU, n, settings);
+    let mut by_stages = RiccatiSolver::new(NX, NU, n, settings);
+    let (mut sol, mut sol_stages) = (QpSolution::new(NX, NU, n), QpSolution::new(NX, NU, n));
+    let mut scratch = OcpQp::new(NX, NU, n);
+    let mut taken = 0;
+    for sample in 0..12 {
+        let stages = StageQp::<NX, NU>::from_ocp(&qp).expect("sizes");
+        let status = by_ocp.solve(&qp, &mut sol);
+        assert_eq!(status, QpStatus::Solved, "({NX}, {NU}) sample {sample}");
+        let status = by_stages.solve_stages(&stages, &mut scratch, &mut sol_stages);
+        assert_eq!(status, QpStatus::Solved, "({NX}, {NU}) sample {sample}");
+        // The same arithmetic in the same order: the same bits.
+        assert_eq!(
+            format!("{sol:?}"),
+            format!("{sol_stages:?}"),
+            "({NX}, {NU}) {sample}"
+        );
+        assert_eq!(
+            by_ocp.info(),
+            by_stages.info(),
+            "({NX}, {NU}) sample {sample}"
+        );
+        taken += usize::from(by_stages.info().active_set_start);
+        by_ocp.shift_warm_start(true);
+        by_stages.shift_warm_start(true);
+        qp = perturbed(&shifted(&qp), rng, 0.01);
+    }
+    // The runtime-size core has no active-set start.
+    let fixed = NX == 2 * NU;
+    assert!(
+        !fixed || taken >= 6,
+        "({NX}, {NU}): the active-set start took {taken} of 12"
+    );
+
+    // Bad data is refused as on the other path, and the solver recovers.
+    let good = StageQp::<NX, NU>::from_ocp(&qp).expect("sizes");
+    type Corrupt<const NX: usize, const NU: usize> = fn(&mut StageQp<NX, NU>);
+    let cases: [(&str, Corrupt<NX, NU>); 6] = [
+        ("NaN in A", |qp| qp.stages[3].a[(1, 0)] = f64::NAN),
+        ("Inf in c", |qp| qp.stages[5].c[0] = f64::INFINITY),
+        ("NaN in Q_N", |qp| qp.stages[40].q[(0, 0)] = f64::NAN),
+        ("NaN in x0", |qp| qp.x0[0] = f64::NAN),
+        ("crossed control bounds", |qp| {
+            qp.stages[4].u_lower[0] = 1.0;
+            qp.stages[4].u_upper[0] = -1.0;
+        }),
+        ("asymmetric R", |qp| {
+            qp.stages[1].r[(NU - 1, 0)] += if NU > 1 { 1.0 } else { 0.0 };
+            qp.stages[1].q[(NX - 1, 0)] += 1.0;
+        }),
+    ];
+    for (what, corrupt) in cases {
+        let mut bad = good.clone();
+        corrupt(&mut bad);
+        let status = by_stages.solve_stages(&bad, &mut scratch, &mut sol_stages);
+        assert_eq!(status, QpStatus::InvalidInput, "({NX}, {NU}) {what}");
+        assert!(sol_stages.objective.is_nan(), "({NX}, {NU}) {what}");
+        let status = by_stages.solve_stages(&good, &mut scratch, &mut sol_stages);
+        assert_eq!(status, QpStatus::Solved, "({NX}, {NU}) after {what}");
+    }
+    // Another horizon, or other sizes, reach the converted path's refusal.
+    let longer = StageQp::<NX, NU>::from_ocp(&random_ocp_qp(rng, NX, NU, n + 1)).expect("sizes");
+    let status = by_stages.solve_stages(&longer, &mut scratch, &mut sol_stages);
+    assert_eq!(
+        status,
+        QpStatus::InvalidInput,
+        "({NX}, {NU}) longer horizon"
+    );
+    let other = StageQp::<3, 1>::from_ocp(&random_ocp_qp(rng, 3, 1, n)).expect("sizes");
+    let status = by_stages.solve_stages(&other, &mut scratch, &mut sol_stages);
+    assert_eq!(status, QpStatus::InvalidInput, "({NX}, {NU}) other sizes");
+}
+
+#[test]
+fn the_stage_wise_form_solves_as_the_ocp_form() {
+    // (4, 2), (6, 3), (2, 1): the compile-time-sized cores read the stages
+    // directly; (5, 2): the runtime-size core gets them converted.
+    let mut rng = SplitMix64::new(22);
+    stage_wise_matches::<4, 2>(&mut rng);
+    stage_wise_matches::<6, 3>(&mut rng);
+    stage_wise_matches::<2, 1>(&mut rng);
+    stage_wise_matches::<5, 2>(&mut rng);
 }

@@ -61,12 +61,12 @@ fn check_scenario(
         if i % stride == 0 {
             let (qp, sol) = ctrl.last_qp();
             assert_eq!(sol.status, QpStatus::Solved, "{what} sample {i}");
-            let status = clarabel.solve(qp, &mut reference_sol);
+            let status = clarabel.solve(&qp, &mut reference_sol);
             assert_eq!(status, QpStatus::Solved, "{what} sample {i}: clarabel");
             let du0 = (&sol.u[0] - &reference_sol.u[0]).amax();
             let objective_rel = (sol.objective - reference_sol.objective).abs()
                 / reference_sol.objective.abs().max(1.0);
-            let kkt = kkt_residuals(qp, sol);
+            let kkt = kkt_residuals(&qp, sol);
             assert!(
                 du0 <= U0_TOL,
                 "{what} sample {i}: first control differs by {du0:e}\nriccati {:?} obj {} it {} kkt {:?}\nclarabel {:?} obj {} kkt {:?}",
@@ -76,7 +76,7 @@ fn check_scenario(
                 kkt,
                 reference_sol.u[0].as_slice(),
                 reference_sol.objective,
-                kkt_residuals(qp, &reference_sol)
+                kkt_residuals(&qp, &reference_sol)
             );
             assert!(
                 objective_rel <= OBJ_REL_TOL,

@@ -137,18 +137,18 @@ where
             let (x_next, a, b) = self.interval_sensitivity_from(z, u, substeps, &first);
             let m =
                 stage_model_at::<S, N, NX>(&self.system, &self.reference, &cost, z, u, dt, &energy);
-            self.qp.a[k].copy_from(&a);
-            self.qp.b[k].copy_from(&b);
-            self.qp.c[k].copy_from(&(x_next - self.xs[k + 1]));
-            self.qp.q[k].copy_from(&m.q);
-            self.qp.s[k].copy_from(&m.s);
-            self.qp.r[k].copy_from(&m.r);
-            self.qp.q_lin[k].copy_from(&m.gz);
-            self.qp.r_lin[k].copy_from(&m.gu);
-            for i in 0..N {
-                self.qp.u_lower[k][i] = -self.config.tau_max - self.us[k][i];
-                self.qp.u_upper[k][i] = self.config.tau_max - self.us[k][i];
-            }
+            let tau_max = Vector::<N>::repeat(self.config.tau_max);
+            let st = &mut self.stages.stages[k];
+            st.a = a;
+            st.b = b;
+            st.c = x_next - self.xs[k + 1];
+            st.q = m.q;
+            st.s = m.s;
+            st.r = m.r;
+            st.q_lin = m.gz;
+            st.r_lin = m.gu;
+            st.u_lower = -tau_max - self.us[k];
+            st.u_upper = tau_max - self.us[k];
         }
         self.substeps_taken = substeps_taken;
         let scale = dt * self.config.terminal_scale;
@@ -161,19 +161,19 @@ where
                 &Vector::zeros(),
                 scale,
             );
-            self.qp.q[nh].copy_from(&m.q);
-            self.qp.q_lin[nh].copy_from(&m.gz);
+            self.stages.stages[nh].q = m.q;
+            self.stages.stages[nh].q_lin = m.gz;
         } else {
-            self.qp.q[nh].fill(0.0);
-            self.qp.q_lin[nh].fill(0.0);
+            self.stages.stages[nh].q.fill(0.0);
+            self.stages.stages[nh].q_lin.fill(0.0);
         }
         for k in 1..=nh {
+            let (x, st) = (&self.xs[k], &mut self.stages.stages[k]);
             for i in 0..N {
-                let x = &self.xs[k];
-                self.qp.x_lower[k][i] = q_eq[i] - self.config.q_max - x[i];
-                self.qp.x_upper[k][i] = q_eq[i] + self.config.q_max - x[i];
-                self.qp.x_lower[k][N + i] = -self.config.qd_max - x[N + i];
-                self.qp.x_upper[k][N + i] = self.config.qd_max - x[N + i];
+                st.x_lower[i] = q_eq[i] - self.config.q_max - x[i];
+                st.x_upper[i] = q_eq[i] + self.config.q_max - x[i];
+                st.x_lower[N + i] = -self.config.qd_max - x[N + i];
+                st.x_upper[N + i] = self.config.qd_max - x[N + i];
             }
         }
     }

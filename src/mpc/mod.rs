@@ -51,7 +51,7 @@ pub use status::{ControlOutput, ControlStatus};
 use crate::mechanics::{MechanicalSystem, Vector, state_energy};
 use crate::modes::ChartFamily;
 pub use crate::qp::QpBackend;
-use crate::qp::{OcpQp, QpSolution, QpSolver};
+use crate::qp::{AnyStageQp, OcpQp, QpSolution, QpSolver, StageQp};
 use config::validate_cost;
 use nalgebra::SVector;
 use std::time::Instant;
@@ -67,6 +67,11 @@ pub struct Controller<S, const N: usize, const NX: usize> {
     /// Line-search trial iterate.
     xs_trial: Vec<SVector<f64, NX>>,
     us_trial: Vec<Vector<N>>,
+    /// The QP of the current linearisation, stage by stage (what the
+    /// linearisation writes and the Riccati solver reads).
+    stages: StageQp<NX, N>,
+    /// The same QP for a solver without a typed path (clarabel, the
+    /// run-time-sized Riccati core): converted into this at each solve.
     qp: OcpQp,
     solution: QpSolution,
     solver: Box<dyn QpSolver + Send>,
@@ -126,13 +131,15 @@ where
         config.validate()?;
         reference.validate().map_err(MpcError::InvalidReference)?;
         let nh = config.horizon;
-        let mut qp = OcpQp::new(NX, N, nh);
-        for k in 0..nh {
-            qp.u_lower[k].fill(-config.tau_max);
-            qp.u_upper[k].fill(config.tau_max);
+        let mut stages = StageQp::<NX, N>::new(nh);
+        for st in &mut stages.stages[..nh] {
+            st.u_lower.fill(-config.tau_max);
+            st.u_upper.fill(config.tau_max);
         }
-        qp.soft_l1.fill(config.soft_l1);
-        qp.soft_l2.fill(config.soft_l2);
+        stages.soft_l1.fill(config.soft_l1);
+        stages.soft_l2.fill(config.soft_l2);
+        let mut qp = OcpQp::new(NX, N, nh);
+        stages.write_ocp(&mut qp);
         Ok(Self {
             system,
             config,
@@ -141,6 +148,7 @@ where
             us: vec![Vector::zeros(); nh],
             xs_trial: vec![SVector::zeros(); nh + 1],
             us_trial: vec![Vector::zeros(); nh],
+            stages,
             qp,
             solution: QpSolution::new(NX, N, nh),
             solver,
@@ -291,9 +299,15 @@ where
         &self.us
     }
 
-    /// The last QP and its solution (diagnostics, tests).
-    pub fn last_qp(&self) -> (&OcpQp, &QpSolution) {
-        (&self.qp, &self.solution)
+    /// The last QP and its solution (diagnostics, tests; the QP converted
+    /// from the stage-wise form, which allocates).
+    pub fn last_qp(&self) -> (OcpQp, &QpSolution) {
+        (self.stages.to_ocp(), &self.solution)
+    }
+
+    /// The last QP as the controller holds it, stage by stage.
+    pub fn last_stage_qp(&self) -> &StageQp<NX, N> {
+        &self.stages
     }
 
     /// RK4 substeps the last linearisation took over all `N` intervals
@@ -514,7 +528,7 @@ where
                 self.linearise();
             }
             self.set_initial_state(z);
-            let status = self.solver.solve(&self.qp, &mut self.solution);
+            let status = self.solve_qp();
             qp_iterations += self.solution.iterations;
             if !status.is_usable() {
                 return self.fallback(ControlStatus::QpFailed(status));
@@ -585,7 +599,13 @@ where
     }
 
     fn set_initial_state(&mut self, z: &SVector<f64, NX>) {
-        self.qp.x0.copy_from(&(z - self.xs[0]));
+        self.stages.x0 = z - self.xs[0];
+    }
+
+    /// Solves the linearisation's QP into `solution`.
+    fn solve_qp(&mut self) -> crate::qp::QpStatus {
+        self.solver
+            .solve_stages(&self.stages, &mut self.qp, &mut self.solution)
     }
 
     fn apply_step(&mut self, alpha: f64) {

@@ -25,7 +25,7 @@ where
                 self.linearise();
             }
             self.set_initial_state(z);
-            let status = self.solver.solve(&self.qp, &mut self.solution);
+            let status = self.solve_qp();
             qp_iterations += self.solution.iterations;
             if !status.is_usable() {
                 return self.fallback(ControlStatus::QpFailed(status));
@@ -106,14 +106,14 @@ where
             max_pi = max_pi.max(pi.amax());
         }
         // The multiplier of the initial-state constraint, from stationarity at x_0.
-        let (qp, sol) = (&self.qp, &self.solution);
+        let (first, sol) = (&self.stages.stages[0], &self.solution);
         for i in 0..NX {
-            let mut lam = qp.q_lin[0][i];
+            let mut lam = first.q_lin[i];
             for j in 0..NX {
-                lam += qp.q[0][(i, j)] * sol.x[0][j] + qp.a[0][(j, i)] * sol.pi[0][j];
+                lam += first.q[(i, j)] * sol.x[0][j] + first.a[(j, i)] * sol.pi[0][j];
             }
             for j in 0..N {
-                lam += qp.s[0][(j, i)] * sol.u[0][j];
+                lam += first.s[(j, i)] * sol.u[0][j];
             }
             max_pi = max_pi.max(lam.abs());
         }
@@ -122,17 +122,17 @@ where
 
         let mut step_norm: f64 = 0.0;
         let mut slope = 0.0;
-        let mut violation = self.qp.x0.lp_norm(1);
-        for k in 0..nh {
+        let stages = &self.stages.stages;
+        let mut violation = self.stages.x0.lp_norm(1);
+        for (k, st) in stages[..nh].iter().enumerate() {
             step_norm = step_norm
                 .max(self.solution.x[k].amax())
                 .max(self.solution.u[k].amax());
-            slope += self.qp.q_lin[k].dot(&self.solution.x[k])
-                + self.qp.r_lin[k].dot(&self.solution.u[k]);
-            violation += self.qp.c[k].lp_norm(1);
+            slope += st.q_lin.dot(&self.solution.x[k]) + st.r_lin.dot(&self.solution.u[k]);
+            violation += st.c.lp_norm(1);
         }
         step_norm = step_norm.max(self.solution.x[nh].amax());
-        slope += self.qp.q_lin[nh].dot(&self.solution.x[nh]);
+        slope += stages[nh].q_lin.dot(&self.solution.x[nh]);
         let slope = slope - mu * violation;
 
         let base = self.merit(&self.xs, &self.us, z, mu);

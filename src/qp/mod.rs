@@ -27,12 +27,14 @@ pub mod kkt;
 #[cfg(feature = "tooling")]
 pub mod record;
 pub mod riccati;
+pub mod stages;
 #[cfg(feature = "tooling")]
 pub mod synthetic;
 
 #[cfg(feature = "tooling")]
 pub use kkt::{KktResiduals, kkt_residuals};
 pub use riccati::{RiccatiInfo, RiccatiSettings, RiccatiSolver};
+pub use stages::{AnyStageQp, QpStage, StageQp};
 
 /// Stage-wise optimal-control QP (see the module documentation).
 #[derive(Clone, Debug)]
@@ -271,6 +273,20 @@ pub trait QpSolver {
     /// Solves `qp` into `solution` (overwritten in place); returns the status
     /// that is also stored in `solution.status`. Never panics on bad data.
     fn solve(&mut self, qp: &OcpQp, solution: &mut QpSolution) -> QpStatus;
+    /// [`QpSolver::solve`] of a QP stored stage by stage ([`StageQp`]),
+    /// the controller's form. Default: converted into `scratch` (allocated
+    /// once at the right sizes, so the conversion does not allocate) and
+    /// solved; a solver with a typed path for these sizes reads the stages
+    /// directly and leaves `scratch` alone.
+    fn solve_stages(
+        &mut self,
+        qp: &dyn AnyStageQp,
+        scratch: &mut OcpQp,
+        solution: &mut QpSolution,
+    ) -> QpStatus {
+        qp.write_ocp(scratch);
+        self.solve(scratch, solution)
+    }
     /// Whether the last solve was finished by a warm or active-set start
     /// without the solver's main method (riccati: its active-set start,
     /// no interior point); `None` for a solver without one. Diagnostics

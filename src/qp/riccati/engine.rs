@@ -49,6 +49,16 @@ pub(super) trait FixedEngine: std::fmt::Debug + Send + Sync {
         warm: bool,
         sol: &mut QpSolution,
     ) -> (QpStatus, RiccatiInfo);
+    /// [`FixedEngine::run`] on the stage-wise form, when `qp` is a
+    /// [`StageQp`] of this core's sizes (`None` otherwise: the caller
+    /// converts it).
+    fn run_stages(
+        &mut self,
+        qp: &dyn std::any::Any,
+        set: &RiccatiSettings,
+        warm: bool,
+        sol: &mut QpSolution,
+    ) -> Option<(QpStatus, RiccatiInfo)>;
     fn save_multipliers(&self, out: &mut Vec<f64>);
     fn restore_multipliers(&mut self, data: &[f64]) -> bool;
     fn boxed_clone(&self) -> Box<dyn FixedEngine>;
@@ -62,7 +72,19 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedEngine for FixedCore
         warm: bool,
         sol: &mut QpSolution,
     ) -> (QpStatus, RiccatiInfo) {
-        run_fixed(self, qp, set, warm, sol)
+        let loaded = self.load(qp, set);
+        run_fixed(self, loaded, set, warm, sol)
+    }
+    fn run_stages(
+        &mut self,
+        qp: &dyn std::any::Any,
+        set: &RiccatiSettings,
+        warm: bool,
+        sol: &mut QpSolution,
+    ) -> Option<(QpStatus, RiccatiInfo)> {
+        let qp = qp.downcast_ref::<StageQp<NX, NU>>()?;
+        let loaded = self.load_stages(qp, set);
+        Some(run_fixed(self, loaded, set, warm, sol))
     }
     fn save_multipliers(&self, out: &mut Vec<f64>) {
         FixedCore::save_multipliers(self, out);
@@ -75,16 +97,17 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedEngine for FixedCore
     }
 }
 
-/// One solve on a compile-time-sized core: the active-set start when it
-/// applies, the interior point otherwise.
-pub(super) fn run_fixed<const NX: usize, const NU: usize, const M: usize>(
+/// One solve on a compile-time-sized core after its load (`loaded`: the
+/// data passed the load's checks): the active-set start when it applies,
+/// the interior point otherwise.
+fn run_fixed<const NX: usize, const NU: usize, const M: usize>(
     core: &mut FixedCore<NX, NU, M>,
-    qp: &OcpQp,
+    loaded: bool,
     set: &RiccatiSettings,
     warm: bool,
     sol: &mut QpSolution,
 ) -> (QpStatus, RiccatiInfo) {
-    if !core.load(qp, set) {
+    if !loaded {
         return (QpStatus::InvalidInput, core.info);
     }
     core.warm = warm;

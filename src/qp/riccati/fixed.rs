@@ -19,8 +19,25 @@ use super::{
     Core, Residuals, RiccatiInfo, RiccatiSettings, SYMMETRY_TOLERANCE, StartShift, add_slot,
     lower_bound_ok, recentred, upper_bound_ok,
 };
-use crate::qp::{OcpQp, QpSolution};
+use crate::qp::{OcpQp, QpSolution, StageQp};
 use nalgebra::{SMatrix, SVector};
+
+/// One stage's data as [`FixedCore::load_with`] reads it: column-major
+/// slices of the stage's sizes.
+struct StageData<'a> {
+    q: &'a [f64],
+    q_lin: &'a [f64],
+    x_lower: &'a [f64],
+    x_upper: &'a [f64],
+    a: &'a [f64],
+    b: &'a [f64],
+    s: &'a [f64],
+    r: &'a [f64],
+    c: &'a [f64],
+    r_lin: &'a [f64],
+    u_lower: &'a [f64],
+    u_upper: &'a [f64],
+}
 
 mod active_set;
 
@@ -289,6 +306,80 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
     /// control bounds, a negative penalty or an asymmetric `Q` or `R` (the
     /// same rules as the runtime-size core's `valid_data`).
     pub(super) fn load(&mut self, qp: &OcpQp, set: &RiccatiSettings) -> bool {
+        self.load_with(
+            qp.soft_l1.as_slice(),
+            qp.soft_l2.as_slice(),
+            qp.x0.as_slice(),
+            set,
+            |k| {
+                // The last stage has no control or dynamics blocks.
+                fn pick(v: &[nalgebra::DMatrix<f64>], k: usize) -> &[f64] {
+                    v.get(k).map_or(&[], |m| m.as_slice())
+                }
+                fn pick_v(v: &[nalgebra::DVector<f64>], k: usize) -> &[f64] {
+                    v.get(k).map_or(&[], |m| m.as_slice())
+                }
+                StageData {
+                    q: qp.q[k].as_slice(),
+                    q_lin: qp.q_lin[k].as_slice(),
+                    x_lower: qp.x_lower[k].as_slice(),
+                    x_upper: qp.x_upper[k].as_slice(),
+                    a: pick(&qp.a, k),
+                    b: pick(&qp.b, k),
+                    s: pick(&qp.s, k),
+                    r: pick(&qp.r, k),
+                    c: pick_v(&qp.c, k),
+                    r_lin: pick_v(&qp.r_lin, k),
+                    u_lower: pick_v(&qp.u_lower, k),
+                    u_upper: pick_v(&qp.u_upper, k),
+                }
+            },
+        )
+    }
+
+    /// [`FixedCore::load`] from the stage-wise form of the same sizes (no
+    /// dimension checks: the types hold them; false for another horizon).
+    pub(super) fn load_stages(&mut self, qp: &StageQp<NX, NU>, set: &RiccatiSettings) -> bool {
+        if qp.stages.len() != self.st.len() {
+            return false;
+        }
+        self.load_with(
+            qp.soft_l1.as_slice(),
+            qp.soft_l2.as_slice(),
+            qp.x0.as_slice(),
+            set,
+            |k| {
+                let st = &qp.stages[k];
+                StageData {
+                    q: st.q.as_slice(),
+                    q_lin: st.q_lin.as_slice(),
+                    x_lower: st.x_lower.as_slice(),
+                    x_upper: st.x_upper.as_slice(),
+                    a: st.a.as_slice(),
+                    b: st.b.as_slice(),
+                    s: st.s.as_slice(),
+                    r: st.r.as_slice(),
+                    c: st.c.as_slice(),
+                    r_lin: st.r_lin.as_slice(),
+                    u_lower: st.u_lower.as_slice(),
+                    u_upper: st.u_upper.as_slice(),
+                }
+            },
+        )
+    }
+
+    /// The loader of [`FixedCore::load`] and [`FixedCore::load_stages`]:
+    /// `stage(k)` gives stage `k`'s data (its control and dynamics slices
+    /// are read for `k < N` only).
+    #[inline(always)]
+    fn load_with<'a>(
+        &mut self,
+        l1: &[f64],
+        l2: &[f64],
+        x0: &[f64],
+        set: &RiccatiSettings,
+        stage: impl Fn(usize) -> StageData<'a>,
+    ) -> bool {
         let n = self.n;
         self.set = *set;
         self.info = RiccatiInfo::default();
@@ -300,27 +391,28 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
                 probe[i & 3] += nan_probe(*v);
             }
         };
-        copy(self.l1.as_mut_slice(), qp.soft_l1.as_slice());
-        copy(self.l2.as_mut_slice(), qp.soft_l2.as_slice());
-        copy(self.x0.as_mut_slice(), qp.x0.as_slice());
+        copy(self.l1.as_mut_slice(), l1);
+        copy(self.l2.as_mut_slice(), l2);
+        copy(self.x0.as_mut_slice(), x0);
         let mut ok = self.l1.iter().chain(self.l2.iter()).all(|&w| w >= 0.0);
         let mut m_on = 0.0;
         self.soft_any = false;
         for (k, st) in self.st.iter_mut().enumerate() {
-            copy(st.q.as_mut_slice(), qp.q[k].as_slice());
-            copy(st.ql.as_mut_slice(), qp.q_lin[k].as_slice());
+            let data = stage(k);
+            copy(st.q.as_mut_slice(), data.q);
+            copy(st.ql.as_mut_slice(), data.q_lin);
             ok &= symmetric(&st.q);
             st.mask = [0.0; M];
             st.off = [0.0; M];
             if k < n {
-                copy(st.a.as_mut_slice(), qp.a[k].as_slice());
-                copy(st.b.as_mut_slice(), qp.b[k].as_slice());
-                copy(st.c.as_mut_slice(), qp.c[k].as_slice());
-                copy(st.s.as_mut_slice(), qp.s[k].as_slice());
-                copy(st.r.as_mut_slice(), qp.r[k].as_slice());
-                copy(st.rl.as_mut_slice(), qp.r_lin[k].as_slice());
+                copy(st.a.as_mut_slice(), data.a);
+                copy(st.b.as_mut_slice(), data.b);
+                copy(st.c.as_mut_slice(), data.c);
+                copy(st.s.as_mut_slice(), data.s);
+                copy(st.r.as_mut_slice(), data.r);
+                copy(st.rl.as_mut_slice(), data.r_lin);
                 ok &= symmetric(&st.r);
-                let (lo, hi) = (&qp.u_lower[k], &qp.u_upper[k]);
+                let (lo, hi) = (data.u_lower, data.u_upper);
                 for j in 0..NU {
                     ok &= lower_bound_ok(lo[j]) && upper_bound_ok(hi[j]) && lo[j] <= hi[j];
                     if lo[j].is_finite() {
@@ -335,7 +427,7 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
             }
             st.soft = Vecn::zeros();
             // x_0 is fixed: its bounds are ignored, but must be valid too.
-            let (lo, hi) = (&qp.x_lower[k], &qp.x_upper[k]);
+            let (lo, hi) = (data.x_lower, data.x_upper);
             for i in 0..NX {
                 ok &= lower_bound_ok(lo[i]) && upper_bound_ok(hi[i]);
             }

@@ -38,7 +38,7 @@
 //! recursion, `cholesky.rs` the stage factorisation, `fixed.rs` the
 //! compile-time-sized cores (and their active-set start).
 
-use super::{OcpQp, QpSolution, QpSolver, QpStatus};
+use super::{AnyStageQp, OcpQp, QpSolution, QpSolver, QpStatus, StageQp};
 
 mod checks;
 mod cholesky;
@@ -320,6 +320,42 @@ impl QpSolver for RiccatiSolver {
         } else {
             self.run(qp, solution)
         };
+        self.finish(status, solution)
+    }
+
+    fn solve_stages(
+        &mut self,
+        qp: &dyn AnyStageQp,
+        scratch: &mut OcpQp,
+        solution: &mut QpSolution,
+    ) -> QpStatus {
+        // The compile-time-sized core of these sizes reads the stages as
+        // they are; any other core gets the converted QP.
+        let typed = match &mut self.engine {
+            Engine::Fixed(core) if qp.dimensions() == (self.nx, self.nu, self.horizon) => {
+                if valid_solution(solution, self.nx, self.nu, self.horizon) {
+                    self.info = RiccatiInfo::default();
+                    core.run_stages(qp.as_any(), &self.settings, self.warm_next, solution)
+                } else {
+                    Some((QpStatus::InvalidInput, RiccatiInfo::default()))
+                }
+            }
+            _ => None,
+        };
+        let Some((status, info)) = typed else {
+            qp.write_ocp(scratch);
+            return self.solve(scratch, solution);
+        };
+        self.info = info;
+        self.total_regularised += self.info.regularised_pivots as u64;
+        self.finish(status, solution)
+    }
+}
+
+impl RiccatiSolver {
+    /// The end of every solve: the warm start is used up, the status
+    /// stored, and an invalid QP's solution marked as such.
+    fn finish(&mut self, status: QpStatus, solution: &mut QpSolution) -> QpStatus {
         self.warm_next = false;
         solution.status = status;
         if status == QpStatus::InvalidInput {
