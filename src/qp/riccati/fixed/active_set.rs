@@ -164,7 +164,6 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
             let pa = p_next * st.a;
             let pb = p_next * st.b;
             let h = p_next * st.c + pv_next;
-            let qxx = st.q + st.a.tr_mul(&pa);
             let qux = st.s + st.b.tr_mul(&pa);
             let quu = st.r + st.b.tr_mul(&pb);
             let qx = st.ql + st.a.tr_mul(&h);
@@ -214,12 +213,27 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
             // and the fixed rows of gain are zero, so gain' Quu gain =
             // -gain' Qux and gain' Quu feed = -gain' qu: the quadratic and
             // linear terms reduce to the familiar Riccati update.
-            let p_mat = qxx + qux.tr_mul(&gain);
+            // P = Q + A' P' A + Qux' gain: its lower triangle, mirrored
+            // (symmetric by construction, and half the products).
+            let mut p_mat = Mat::<NX, NX>::zeros();
+            for c in 0..NX {
+                for r in c..NX {
+                    let mut v = st.q[(r, c)];
+                    for i in 0..NX {
+                        v += st.a[(i, r)] * pa[(i, c)];
+                    }
+                    for j in 0..NU {
+                        v += qux[(j, r)] * gain[(j, c)];
+                    }
+                    p_mat[(r, c)] = v;
+                    p_mat[(c, r)] = v;
+                }
+            }
             let p_vec = qx + qux.tr_mul(&feed);
             let gs = &mut self.guess[k];
             gs.gain = gain;
             gs.feed = feed;
-            gs.p_mat = 0.5 * (p_mat + p_mat.transpose());
+            gs.p_mat = p_mat;
             gs.p_vec = p_vec;
         }
         true
@@ -344,28 +358,34 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
         for k in 0..=n {
             let st = &mut self.st[k];
             st.sl = Vecn::zeros();
-            let cv = st.constraint_values();
-            for i in 0..M {
-                st.t[i] = if st.mask[i] > 0.0 {
-                    cv[i].max(0.0)
-                } else {
-                    1.0
-                };
-                st.lam[i] = 0.0;
+            // No state bound has a slot (`soft_any` is false): their
+            // slack and multiplier are the absent slots' 1 and 0.
+            st.t = [1.0; M];
+            st.lam = [0.0; M];
+            if k == n {
+                continue;
             }
-            if k < n {
-                for j in 0..NU {
-                    match self.guess[k].guess[j] {
-                        Bound::Lower => {
-                            st.lam[j] = st.ru[j].max(0.0);
-                            st.t[j] = 0.0;
-                        }
-                        Bound::Upper => {
-                            st.lam[NU + j] = (-st.ru[j]).max(0.0);
-                            st.t[NU + j] = 0.0;
-                        }
-                        Bound::Free => {}
+            for j in 0..NU {
+                let (lower, upper) = (j, NU + j);
+                match self.guess[k].guess[j] {
+                    Bound::Lower => {
+                        st.lam[lower] = st.ru[j].max(0.0);
+                        st.t[lower] = 0.0;
                     }
+                    _ if st.mask[lower] > 0.0 => {
+                        st.t[lower] = (st.u[j] + st.off[lower]).max(0.0);
+                    }
+                    _ => {}
+                }
+                match self.guess[k].guess[j] {
+                    Bound::Upper => {
+                        st.lam[upper] = (-st.ru[j]).max(0.0);
+                        st.t[upper] = 0.0;
+                    }
+                    _ if st.mask[upper] > 0.0 => {
+                        st.t[upper] = (st.off[upper] - st.u[j]).max(0.0);
+                    }
+                    _ => {}
                 }
             }
         }
