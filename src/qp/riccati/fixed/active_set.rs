@@ -77,13 +77,18 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
         }
         self.first_guess();
         let mut guesses = 0;
+        // The stages whose policy the next recursion computes: all at
+        // first, then those up to the last changed guess (the cost-to-go
+        // of a stage depends only on the guesses after it).
+        let mut last = self.n - 1;
         let optimal = loop {
             guesses += 1;
-            if !self.policy() {
+            if !self.policy(last) {
                 break false;
             }
-            if self.simulate_and_update() == 0 {
-                break true;
+            match self.simulate_and_update() {
+                None => break true,
+                Some(changed) => last = changed,
             }
             if guesses >= max_guesses {
                 break false;
@@ -151,14 +156,18 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
     }
 
     /// Backward recursion of the current guess: the policy and cost-to-go
-    /// of every stage. False when a free control block is not clearly
-    /// positive definite (the interior point then regularises it).
-    fn policy(&mut self) -> bool {
+    /// of stages `last` down to 0 (the later ones' are the last
+    /// recursion's, which the guess did not change there; `last = N - 1`:
+    /// all). False when a free control block is not clearly positive
+    /// definite (the interior point then regularises it).
+    fn policy(&mut self, last: usize) -> bool {
         let n = self.n;
         let tol = self.set.pivot_tolerance;
-        self.guess[n].p_mat = self.st[n].q;
-        self.guess[n].p_vec = self.st[n].ql;
-        for k in (0..n).rev() {
+        if last + 1 == n {
+            self.guess[n].p_mat = self.st[n].q;
+            self.guess[n].p_vec = self.st[n].ql;
+        }
+        for k in (0..=last).rev() {
             let (p_next, pv_next) = (self.guess[k + 1].p_mat, self.guess[k + 1].p_vec);
             let st = &self.st[k];
             let pa = p_next * st.a;
@@ -240,11 +249,12 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
     }
 
     /// Forward sweep of the current policy into the iterate (`x`, `u`,
-    /// `pi`), then the next guess; returns how many components changed.
-    fn simulate_and_update(&mut self) -> usize {
+    /// `pi`), then the next guess; returns the last stage whose guess
+    /// changed, `None` when none did (the guess is optimal).
+    fn simulate_and_update(&mut self) -> Option<usize> {
         let n = self.n;
         let (tol_stat, tol_feas) = (self.set.tol_stationarity, self.set.tol_feasibility);
-        let mut changed = 0;
+        let mut changed = None;
         let mut scale = 0.0f64;
         self.st[0].x = self.x0;
         for k in 0..n {
@@ -275,7 +285,9 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
                     }
                     b => b,
                 };
-                changed += usize::from(next != guess[j]);
+                if next != guess[j] {
+                    changed = Some(k);
+                }
                 guess[j] = next;
             }
             self.guess[k].guess = guess;
