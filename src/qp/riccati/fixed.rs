@@ -395,6 +395,10 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
         copy(self.l2.as_mut_slice(), l2);
         copy(self.x0.as_mut_slice(), x0);
         let mut ok = self.l1.iter().chain(self.l2.iter()).all(|&w| w >= 0.0);
+        // A bound whose weights are both zero costs nothing to violate:
+        // ignored (as in the KKT checker).
+        let weighted: [bool; NX] = std::array::from_fn(|i| self.l1[i] > 0.0 || self.l2[i] > 0.0);
+        let any_weighted = weighted.iter().any(|&w| w);
         let mut m_on = 0.0;
         self.soft_any = false;
         for (k, st) in self.st.iter_mut().enumerate() {
@@ -431,13 +435,11 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
             for i in 0..NX {
                 ok &= lower_bound_ok(lo[i]) && upper_bound_ok(hi[i]);
             }
-            if k >= 1 {
+            if k >= 1 && any_weighted {
                 for i in 0..NX {
-                    // A bound whose weights are both zero costs nothing to
-                    // violate: ignored (as in the KKT checker).
-                    let weighted = self.l1[i] > 0.0 || self.l2[i] > 0.0;
                     let (fl, fh) = (lo[i].is_finite(), hi[i].is_finite());
-                    if weighted && (fl || fh) {
+                    if weighted[i] && (fl || fh) {
+                        self.soft_any = true;
                         st.soft[i] = 1.0;
                         st.mask[2 * NU + 2 * NX + i] = 1.0;
                         if fl {
@@ -452,7 +454,6 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
                 }
             }
             m_on += st.mask.iter().sum::<f64>();
-            self.soft_any |= st.soft.iter().any(|&v| v > 0.0);
         }
         self.m_on = m_on as usize;
         ok && probe.iter().sum::<f64>() == 0.0
@@ -1075,9 +1076,11 @@ impl<const NX: usize, const NU: usize, const M: usize> Core for FixedCore<NX, NU
                     .copy_from_slice(&st.lam[NU..2 * NU]);
                 obj += st.u.dot(&(0.5 * (st.r * st.u) + st.s * st.x + st.rl));
             }
-            for i in 0..NX {
-                let s = st.sl[i];
-                obj += st.soft[i] * (l1[i] * s + 0.5 * l2[i] * s * s);
+            if self.soft_any {
+                for i in 0..NX {
+                    let s = st.sl[i];
+                    obj += st.soft[i] * (l1[i] * s + 0.5 * l2[i] * s * s);
+                }
             }
         }
         sol.objective = obj;
