@@ -180,16 +180,21 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
             // Free rows: the stationarity of the free controls with the
             // fixed ones moved to the right; fixed rows: u_j = bound.
             let guess = self.guess[k].guess;
+            let any_fixed = guess.iter().any(|&b| b != Bound::Free);
             let mut fixed = Vecn::<NU>::zeros();
-            for j in 0..NU {
+            let mut hm = quu;
+            let mut g = qux;
+            let mut rhs = -qu;
+            // The common stage, nothing fixed, skips the elimination.
+            for j in (0..NU).filter(|_| any_fixed) {
                 if guess[j] != Bound::Free {
                     fixed[j] = self.bound_value(k, j, guess[j]);
                 }
             }
-            let mut hm = quu;
-            let mut g = qux;
-            let mut rhs = -(qu + quu * fixed);
-            for j in 0..NU {
+            if any_fixed {
+                rhs = -(qu + quu * fixed);
+            }
+            for j in (0..NU).filter(|_| any_fixed) {
                 if guess[j] != Bound::Free {
                     for i in 0..NU {
                         hm[(i, j)] = 0.0;
@@ -212,7 +217,7 @@ impl<const NX: usize, const NU: usize, const M: usize> FixedCore<NX, NU, M> {
             }
             let gain = -llt_solve(&hm, &inv, &g);
             let mut feed = llt_solve(&hm, &inv, &rhs);
-            for j in 0..NU {
+            for j in (0..NU).filter(|_| any_fixed) {
                 if guess[j] != Bound::Free {
                     feed[j] = fixed[j];
                 }
