@@ -36,7 +36,7 @@ total() { # function-pattern start seconds qp variant -> instructions
 count() { # start seconds qp variant [robot energy tau_max] -> "step linearise qp"
     echo "$(total '*Controller<S,_,_>::step' "$@") \
 $(total '*Controller<S,_,_>>::linearise' "$@") \
-$(total '*as eigenmpc::qp::QpSolver>::solve' "$@")"
+$(total '*QpSolver*::solve_stages' "$@")"
 }
 per_sample() { # start qp variant [robot energy tau_max]
     local a b
