@@ -11,10 +11,8 @@ use nalgebra::{SMatrix, SVector};
 /// acceleration at the interval's start times `dt` (the acceleration
 /// changes within the interval: a margin). Measured on the laboratory
 /// robots (docs/speed.md): 1.0-2.0 give the same closed loops, 1.0-1.25
-/// the fewest substeps. 1.0 against 1.5 (issue 22): A0 756 k -> 713 k,
-/// B0 727 k -> 690 k instructions a sample; band times the same, mean
-/// energy and RMS torque within 0.1 %, robustness scores unchanged.
-pub const SPEED_REACH: f64 = 1.0;
+/// the fewest substeps.
+pub const SPEED_REACH: f64 = 1.5;
 
 impl<S, const N: usize, const NX: usize> Controller<S, N, NX>
 where
