@@ -13,7 +13,8 @@
 //!
 //! `cargo run --release --bin bench_mpc [-- --duration 30]`. Prints
 //! markdown tables (`--list-robots`: the robots, one `FILE ENERGY TAU_MAX`
-//! line each, for `scripts/bench.sh`'s instruction counts). The first sample (the start-up from a zero-torque
+//! line each, for `scripts/bench.sh`'s instruction counts; `--robots-only`:
+//! the robots' table alone, a few seconds). The first sample (the start-up from a zero-torque
 //! guess) is reported separately and excluded from the per-sample
 //! statistics.
 
@@ -124,6 +125,9 @@ fn main() {
             });
     }
     robots_table(duration);
+    if args.iter().any(|a| a == "--robots-only") {
+        return;
+    }
     println!(
         "\n## EigenMPC control step, N = 80, dt = 25 ms, {duration} s closed loop, both QP backends\n"
     );

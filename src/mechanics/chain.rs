@@ -556,6 +556,10 @@ impl<const N: usize> MechanicalSystem<N> for PlanarChain<N> {
         self.equilibrium
     }
 
+    fn has_friction(&self) -> bool {
+        !self.frictionless
+    }
+
     fn friction(&self, qd: &Vector<N>) -> Vector<N> {
         if self.frictionless {
             // The per-sample path of a frictionless model skips the atan.
@@ -951,6 +955,39 @@ mod tests {
             // And the energy is the energy (the springs included once).
             assert!((energy.0 - chain.energy(&q, &qd)).abs() < 1e-12);
         }
+    }
+
+    /// A frictionless chain says so, and its dynamics skip the friction
+    /// with the same bits as the conservative ones; a chain with friction
+    /// on one joint only says it has friction.
+    #[test]
+    fn only_a_frictionless_chain_skips_the_friction() {
+        let p = PlanarChainParams::<3>::point_masses([1.3, 0.7, 0.4], [0.9, 1.2, 0.6], 9.81);
+        let plain = PlanarChain::new(p).unwrap();
+        assert!(!plain.has_friction());
+        assert!(!crate::mechanics::Conservative(&plain).has_friction());
+        let (q, qd) = (
+            Vector::<3>::new(0.3, -1.7, 2.9),
+            Vector::<3>::new(0.4, -0.2, 1.1),
+        );
+        let tau = Vector::<3>::new(0.2, -0.1, 0.05);
+        assert_eq!(
+            plain.dynamics_jacobian(&q, &qd, &tau),
+            plain.conservative_dynamics_jacobian(&q, &qd, &tau)
+        );
+        assert_eq!(
+            plain.forward_dynamics(&q, &qd, &tau),
+            plain.conservative_forward_dynamics(&q, &qd, &tau)
+        );
+        let mut rough = p;
+        rough.joints[2].coulomb = 0.01;
+        let rough = PlanarChain::new(rough).unwrap();
+        assert!(rough.has_friction());
+        assert_ne!(
+            rough.dynamics_jacobian(&q, &qd, &tau),
+            rough.conservative_dynamics_jacobian(&q, &qd, &tau)
+        );
+        assert!(with_every_joint_term(p).has_friction());
     }
 
     /// The two-link Jacobian written out equals the generic one to

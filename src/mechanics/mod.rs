@@ -92,6 +92,13 @@ pub trait MechanicalSystem<const N: usize> {
         Vector::<N>::zeros()
     }
 
+    /// False only when [`friction`](Self::friction) is zero at every
+    /// speed: the dynamics and their Jacobians then skip it and its slope
+    /// (the same results). The default, true, is right for any system.
+    fn has_friction(&self) -> bool {
+        true
+    }
+
     /// Power taken by friction, `tau_f(qd)' qd` (>= 0).
     fn friction_power(&self, qd: &Vector<N>) -> f64 {
         self.friction(qd).dot(qd)
@@ -110,6 +117,9 @@ pub trait MechanicalSystem<const N: usize> {
 
     /// Forward dynamics `qdd = M^-1 (tau - tau_f(qd) - C qd - dV/dq)`.
     fn forward_dynamics(&self, q: &Vector<N>, qd: &Vector<N>, tau: &Vector<N>) -> Vector<N> {
+        if !self.has_friction() {
+            return self.conservative_forward_dynamics(q, qd, tau);
+        }
         self.conservative_forward_dynamics(q, qd, &(tau - self.friction(qd)))
     }
 
@@ -123,6 +133,9 @@ pub trait MechanicalSystem<const N: usize> {
         qd: &Vector<N>,
         tau: &Vector<N>,
     ) -> DynamicsJacobian<N> {
+        if !self.has_friction() {
+            return self.conservative_dynamics_jacobian(q, qd, tau);
+        }
         let mut jac = self.conservative_dynamics_jacobian(q, qd, &(tau - self.friction(qd)));
         add_friction_slope(&mut jac, &self.friction_slope(qd));
         jac
@@ -138,6 +151,9 @@ pub trait MechanicalSystem<const N: usize> {
         qd: &Vector<N>,
         tau: &Vector<N>,
     ) -> (DynamicsJacobian<N>, EnergyWithGradient<N>) {
+        if !self.has_friction() {
+            return self.conservative_dynamics_jacobian_with_energy(q, qd, tau);
+        }
         let (mut jac, energy) =
             self.conservative_dynamics_jacobian_with_energy(q, qd, &(tau - self.friction(qd)));
         add_friction_slope(&mut jac, &self.friction_slope(qd));
@@ -209,6 +225,9 @@ where
     }
     fn equilibrium(&self) -> Vector<N> {
         self.0.equilibrium()
+    }
+    fn has_friction(&self) -> bool {
+        false
     }
     fn conservative_dynamics_jacobian(
         &self,

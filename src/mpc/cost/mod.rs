@@ -186,7 +186,7 @@ where
     let eye = Matrix::<N>::identity();
     // Torque beyond what friction takes: holding an eigenmode against
     // friction costs nothing (for a frictionless model this is `tau`).
-    let (torque, torque_z) = if params.compensate_friction {
+    let (torque, torque_z) = if params.compensate_friction && system.has_friction() {
         let slope = system.friction_slope(&qd);
         let mut dz = SMatrix::<f64, N, NX>::zeros();
         for j in 0..N {
