@@ -202,12 +202,23 @@ fn jacobian_times<const N: usize, const NX: usize, const C: usize>(
     jac: &DynamicsJacobian<N>,
     x: &SMatrix<f64, NX, C>,
 ) -> SMatrix<f64, NX, C> {
-    let top = x.fixed_rows::<N>(0);
-    let bottom = x.fixed_rows::<N>(N);
+    // Written out: nalgebra's products are outlined calls from 3 joints
+    // up, each with its temporary. The same sums in the same order as its
+    // `d_q * top + d_qd * bottom` (each product's terms by ascending
+    // index), so the same bits.
     let mut out = SMatrix::<f64, NX, C>::zeros();
-    out.fixed_rows_mut::<N>(0).copy_from(&bottom);
-    out.fixed_rows_mut::<N>(N)
-        .copy_from(&(jac.d_q * top + jac.d_qd * bottom));
+    for c in 0..C {
+        for r in 0..N {
+            out[(r, c)] = x[(N + r, c)];
+            let mut from_q = jac.d_q[(r, 0)] * x[(0, c)];
+            let mut from_qd = jac.d_qd[(r, 0)] * x[(N, c)];
+            for i in 1..N {
+                from_q += jac.d_q[(r, i)] * x[(i, c)];
+                from_qd += jac.d_qd[(r, i)] * x[(N + i, c)];
+            }
+            out[(N + r, c)] = from_q + from_qd;
+        }
+    }
     out
 }
 

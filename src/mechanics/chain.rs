@@ -825,9 +825,38 @@ impl<const N: usize> PlanarChain<N> {
 }
 
 /// The inverse of a symmetric positive definite `m`, `None` when it is not
-/// (numerically) positive definite. Two links: the closed form.
+/// (numerically) positive definite. Two and three links: the closed form
+/// (the adjugate over the determinant; a generic Cholesky factor and
+/// inverse cost several times more at these sizes).
 #[inline]
 fn spd_inverse<const N: usize>(m: &Matrix<N>) -> Option<Matrix<N>> {
+    if N == 3 {
+        let (a, b, c) = (m[(0, 0)], m[(0, 1)], m[(0, 2)]);
+        let (d, e, f) = (m[(1, 1)], m[(1, 2)], m[(2, 2)]);
+        // The cofactors of the symmetric matrix [a b c; b d e; c e f].
+        let (c00, c01, c02) = (d * f - e * e, c * e - b * f, b * e - c * d);
+        let (c11, c12, c22) = (a * f - c * c, b * c - a * e, a * d - b * b);
+        let det = a * c00 + b * c01 + c * c02;
+        // Sylvester's test, the leading minors positive: what a Cholesky
+        // factorisation's positive pivots say.
+        if !(a > 0.0 && c22 > 0.0 && det > 0.0) {
+            return None;
+        }
+        let s = 1.0 / det;
+        let mut inv = Matrix::<N>::zeros();
+        for (i, j, v) in [
+            (0, 0, c00),
+            (0, 1, c01),
+            (0, 2, c02),
+            (1, 1, c11),
+            (1, 2, c12),
+            (2, 2, c22),
+        ] {
+            inv[(i, j)] = v * s;
+            inv[(j, i)] = v * s;
+        }
+        return Some(inv);
+    }
     if N == 2 {
         let (a, b, d) = (m[(0, 0)], m[(0, 1)], m[(1, 1)]);
         let det = a * d - b * b;
@@ -954,6 +983,41 @@ mod tests {
             assert_eq!(energy, chain.energy_with_gradient(&q, &qd));
             // And the energy is the energy (the springs included once).
             assert!((energy.0 - chain.energy(&q, &qd)).abs() < 1e-12);
+        }
+    }
+
+    /// The closed-form inverses of two and three links are the Cholesky
+    /// one's to rounding, over the mass matrices of a rigid chain with
+    /// motors and of point masses, and refuse what the Cholesky refuses.
+    #[test]
+    fn closed_form_inverses_match_the_cholesky_one() {
+        fn check<const N: usize>(m: &Matrix<N>) {
+            let reference = m.cholesky().unwrap().inverse();
+            let inv = spd_inverse(m).unwrap();
+            let scale = reference.amax() * m.amax();
+            assert!(
+                (inv - reference).amax() <= 1e-14 * reference.amax() * scale,
+                "{m}"
+            );
+            assert_eq!(inv, inv.transpose());
+        }
+        let p3 = PlanarChainParams::<3>::point_masses([1.3, 0.7, 0.4], [0.9, 1.2, 0.6], 9.81);
+        let p2 = PlanarChainParams::<2>::point_masses([1.3, 0.7], [0.9, 1.2], 9.81);
+        for chain in [PlanarChain::new(p3).unwrap(), with_every_joint_term(p3)] {
+            for q in [[0.0, 0.0, 0.0], [0.3, -1.7, 2.9], [3.1, 3.1, -3.1]] {
+                check(&chain.mass_matrix(&Vector::<3>::from(q)));
+            }
+        }
+        let chain = PlanarChain::new(p2).unwrap();
+        check(&chain.mass_matrix(&Vector::<2>::new(0.4, -2.0)));
+        // Indefinite, singular and NaN: refused, as the Cholesky does.
+        for m in [
+            Matrix::<3>::new(1.0, 2.0, 0.0, 2.0, 1.0, 0.0, 0.0, 0.0, 1.0),
+            Matrix::<3>::new(1.0, 0.0, 0.0, 0.0, 1.0, 1.0, 0.0, 1.0, 1.0),
+            Matrix::<3>::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, -1e-3),
+            Matrix::<3>::repeat(f64::NAN),
+        ] {
+            assert!(m.cholesky().is_none() && spd_inverse(&m).is_none(), "{m}");
         }
     }
 

@@ -17,6 +17,12 @@ use nalgebra::{SMatrix, SVector};
 /// and 1.1e-2 (1.0) against 4e-4 here.
 pub const SPEED_REACH: f64 = 1.5;
 
+/// The largest friction slope of `system` with every joint at rest, where
+/// its Coulomb law is steepest (zero without friction).
+pub(super) fn steepest_friction_slope<S: MechanicalSystem<N>, const N: usize>(system: &S) -> f64 {
+    system.friction_slope(&Vector::zeros()).max()
+}
+
 impl<S, const N: usize, const NX: usize> Controller<S, N, NX>
 where
     S: MechanicalSystem<N>,
@@ -54,7 +60,7 @@ where
             return every;
         }
         let most = self.config.substeps;
-        let steepest = self.system.friction_slope(&Vector::zeros()).max();
+        let steepest = self.steepest_friction_slope;
         if steepest.is_nan() || steepest <= 0.0 {
             return most;
         }
@@ -71,7 +77,11 @@ where
         if !slope.is_finite() {
             return most;
         }
-        ((most as f64 * slope / steepest).ceil() as usize).clamp(1, most)
+        // The ceiling of a finite, non-negative share below 2^53, without
+        // `f64::ceil` (a libm call on baseline x86-64).
+        let share = most as f64 * slope / steepest;
+        let whole = share as usize;
+        (whole + usize::from((whole as f64) < share)).clamp(1, most)
     }
 
     pub(super) fn simulate_interval(

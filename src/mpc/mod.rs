@@ -84,6 +84,9 @@ pub struct Controller<S, const N: usize, const NX: usize> {
     merit_penalty: f64,
     /// RK4 substeps of the last linearisation, over all intervals.
     substeps_taken: usize,
+    /// The model's steepest friction slope, every joint at rest (the
+    /// substeps' reference: [`Self::interval_substeps`]); set with the model.
+    steepest_friction_slope: f64,
     /// Preparation time already spent for the coming sample.
     pending_preparation_time: f64,
     /// The last sample's QP solution may seed the next one (warm start).
@@ -140,6 +143,7 @@ where
         stages.soft_l2.fill(config.soft_l2);
         let mut qp = OcpQp::new(NX, N, nh);
         stages.write_ocp(&mut qp);
+        let steepest_friction_slope = linearise::steepest_friction_slope(&system);
         Ok(Self {
             system,
             config,
@@ -157,6 +161,7 @@ where
             shift_pending: false,
             merit_penalty: 1.0,
             substeps_taken: 0,
+            steepest_friction_slope,
             pending_preparation_time: 0.0,
             warm_start_usable: false,
             consecutive_qp_failures: 0,
@@ -235,6 +240,7 @@ where
             }
             _ => {}
         }
+        self.steepest_friction_slope = linearise::steepest_friction_slope(&system);
         self.system = system;
         let old = std::mem::replace(&mut self.family, family);
         if let (Some(f), Some(chart)) = (&self.family, self.reference.chart_mut()) {

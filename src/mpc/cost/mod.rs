@@ -280,9 +280,9 @@ where
     let w = &params.weights;
     let two = 2.0 * scale;
     let q = (r.energy_z * r.energy_z.transpose()) * w.energy
-        + r.position_z.transpose() * r.position_z * w.position
-        + r.velocity_z.transpose() * r.velocity_z * w.velocity
-        + r.torque_z.transpose() * r.torque_z * w.torque;
+        + gram(&r.position_z) * w.position
+        + gram(&r.velocity_z) * w.velocity
+        + gram(&r.torque_z) * w.torque;
     let gz = r.energy_z * (r.energy * w.energy)
         + r.position_z.transpose() * r.position * w.position
         + r.velocity_z.transpose() * r.velocity * w.velocity
@@ -295,6 +295,25 @@ where
         gz: gz * two,
         gu: r.torque_u.transpose() * r.torque * (two * w.torque),
     }
+}
+
+/// `a' a`, written out: nalgebra's product is an outlined call from 3
+/// joints up (with the transpose materialised first). Each entry sums its
+/// terms by ascending row as nalgebra's `a.transpose() * a` does: the same
+/// bits.
+#[inline(always)]
+fn gram<const R: usize, const C: usize>(a: &SMatrix<f64, R, C>) -> SMatrix<f64, C, C> {
+    let mut out = SMatrix::<f64, C, C>::zeros();
+    for c in 0..C {
+        for r in 0..C {
+            let mut v = a[(0, r)] * a[(0, c)];
+            for i in 1..R {
+                v += a[(i, r)] * a[(i, c)];
+            }
+            out[(r, c)] = v;
+        }
+    }
+    out
 }
 
 /// `l = sum_i w_i r_i^2` of one stage's residuals.
