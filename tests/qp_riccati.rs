@@ -281,8 +281,9 @@ fn semidefinite_state_cost() {
 
 #[test]
 fn invalid_input_is_refused() {
-    // (4, 2) runs on a compile-time-sized core, which checks the data while
-    // loading it; (5, 2) on the runtime-size core and its own check.
+    // (4, 2) and (6, 3) run on compile-time-sized cores, which check the
+    // data while loading it (four values at a time and the rest: both
+    // paths); (5, 2) on the runtime-size core and its own check.
     type Corrupt = fn(&mut OcpQp);
     let cases: [(&str, Corrupt); 22] = [
         ("NaN in A", |qp| qp.a[3][(1, 2)] = f64::NAN),
@@ -316,7 +317,7 @@ fn invalid_input_is_refused() {
         }),
     ];
     let mut rng = SplitMix64::new(10);
-    for (nx, nu) in [(4, 2), (5, 2)] {
+    for (nx, nu) in [(4, 2), (6, 3), (5, 2)] {
         let good = with_control_box(random_ocp_qp(&mut rng, nx, nu, 10), 1.0);
         let mut solver = RiccatiSolver::new(nx, nu, 10, RiccatiSettings::default());
         let mut sol = QpSolution::new(nx, nu, 10);
