@@ -68,10 +68,16 @@ per_sample() { # start qp variant [robot energy tau_max]
     echo
     echo "The robots of the table below (curved, riccati, from every joint at 0.05 rad at rest, the controller \`eigenmpc simulate --model FILE\` builds), thousands of instructions per sample from 10 s to 20 s (the friction robots on their orbit by then; the paper's pendulum and the 3 point masses, at 14 J, still in the torque-limited climb):"
     echo
-    echo "| robot | E_ref J | step (k instr.) | linearisation (k instr.) | QP solve (k instr.) |"
-    echo "|---|---|---|---|---|"
+    echo "| robot | E_ref J | step (k instr.) | linearisation (k instr.) | QP solve (k instr.) | step / paper's |"
+    echo "|---|---|---|---|---|---|"
+    paper_step=""
     while read -r robot energy tau_max; do
-        echo "| $(basename "$robot") | $energy | $(per_sample rest riccati curved "$robot" "$energy" "$tau_max") |"
+        cells=$(per_sample rest riccati curved "$robot" "$energy" "$tau_max")
+        step=${cells%% *}
+        # The first robot is the paper's pendulum.
+        paper_step=${paper_step:-$step}
+        ratio=$(awk -v s="$step" -v p="$paper_step" 'BEGIN { printf "%.2f", s / p }')
+        echo "| $(basename "$robot") | $energy | $cells | $ratio |"
     done < <("$target_dir/release/bench_mpc" --list-robots)
     echo
     "$target_dir/release/bench_mpc"

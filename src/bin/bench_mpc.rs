@@ -285,30 +285,32 @@ fn robots_table(duration: f64) {
         cpu()
     );
     println!(
-        "Times in ms; the first sample (the start-up from a zero-torque guess) apart, the others' statistics without it. RK4 substeps: the most an interval takes (what the friction needs with a joint at rest) and the mean over the intervals of all samples (only intervals in which a joint may stop take the most). Preparation is the shift and the linearisation (RK4 substeps with sensitivities, cost Jacobians, the QP's stages), feedback the QP solve. QP recursions: the Riccati recursions of the active-set start where it solves the QP, else the interior point's iterations; \"active-set start\": the share of samples it solved.\n"
+        "Times in ms; the first sample (the start-up from a zero-torque guess) apart, the others' statistics without it. RK4 substeps: the most an interval takes (what the friction needs with a joint at rest) and the mean over the intervals of all samples (only intervals in which a joint may stop take the most). Preparation is the shift and the linearisation (RK4 substeps with sensitivities, cost Jacobians, the QP's stages), feedback the QP solve. QP recursions: the Riccati recursions of the active-set start where it solves the QP, else the interior point's iterations; \"active-set start\": the share of samples it solved. The last column divides the median by the paper pendulum's (the first row) in the same run.\n"
     );
     println!(
-        "| robot | E_ref J | s | RK4 substeps most / mean | band s | first sample | median | p95 | p99 | max | preparation median | feedback median | QP recursions median / max | active-set start |"
+        "| robot | E_ref J | s | RK4 substeps most / mean | band s | first sample | median | p95 | p99 | max | preparation median | feedback median | QP recursions median / max | active-set start | median / paper's |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut paper_median = None;
     for case in ROBOTS {
         let file = RobotFile::load(root.join(case.file)).expect("robot file");
-        let row = match file.links() {
+        let (median, row) = match file.links() {
             2 => robot_row::<2, 4>(&file, case, duration.max(case.duration)),
             3 => robot_row::<3, 6>(&file, case, duration.max(case.duration)),
             n => panic!("{}: {n} links: add its row", case.file),
         };
-        println!("{row}");
+        let paper = *paper_median.get_or_insert(median);
+        println!("{row} {:.2} |", median / paper);
     }
 }
 
-/// One row of [`robots_table`].
+/// One row of [`robots_table`] but its last cell, and the sample median (s).
 fn robot_row<const N: usize, const NX: usize>(
     file: &RobotFile,
     case: &RobotCase,
     duration: f64,
-) -> String {
+) -> (f64, String) {
     let robot = file.chain::<N>().expect("chain");
     let (mut ctrl, _) =
         robot_controller::<N, NX>(&robot, Variant::Curved, case.energy, case.tau_max)
@@ -340,7 +342,7 @@ fn robot_row<const N: usize, const NX: usize>(
     let name = case.file.rsplit('/').next().unwrap_or(case.file);
     let horizon = ctrl.config().horizon;
     let mean_substeps = substeps_taken as f64 / (by_start.len().max(1) * horizon) as f64;
-    format!(
+    let row = format!(
         "| {name} | {} | {duration} | {substeps} / {mean_substeps:.2} | {band} | {:.3} | {} | {:.3} | {:.3} | {:.0} / {:.0} | {:.0} % |",
         case.energy,
         trace[0].solve_time * 1e3,
@@ -350,7 +352,8 @@ fn robot_row<const N: usize, const NX: usize>(
         iters[0],
         iters[3],
         share * 100.0
-    )
+    );
+    (total[0], row)
 }
 
 /// The 3-link point-mass chain (1 kg, 1 m), curved on its in-phase family
