@@ -234,3 +234,54 @@ fn the_chosen_substeps_predict_every_planned_interval_as_all_of_them() {
         assert!(mean < 2.5e-5, "{name}: mean {mean:e}");
     }
 }
+
+/// A saved state carries its model, and a controller restored from it
+/// chooses its substeps against that model's friction, not against the
+/// model it held before (adaptation or `replace_model` may have changed the
+/// friction since the save): it continues as the saved one does, bit for
+/// bit.
+#[test]
+fn a_restored_state_chooses_its_substeps_with_its_own_model() {
+    let robot = lab_robot("lab-double-pendulum-A0.yml");
+    let build = || {
+        robot_controller::<2, 4>(&robot, Variant::Curved, 2.0, 0.5)
+            .unwrap()
+            .0
+    };
+    let (mut saved, mut restored) = (build(), build());
+    let dt = saved.config().dt;
+    let tol = Tolerances {
+        rtol: 1e-9,
+        atol: 1e-9,
+    };
+    let mut z = SVector::<f64, 4>::new(START_ANGLE, START_ANGLE, 0.0, 0.0);
+    for _ in 0..40 {
+        let tau = saved.step(&z).tau;
+        z = simulate_accurate::<_, 2, 4>(&robot, &z, &tau, dt, tol).unwrap();
+    }
+    let state = saved.save_state();
+    // A model with a four times steeper Coulomb law (the same conservative
+    // dynamics, so the same mode family), then the saved state.
+    let mut steeper = *saved.system().params();
+    steeper.coulomb_sharpness *= 4.0;
+    let family = saved.family().cloned();
+    restored
+        .replace_model(PlanarChain::new(steeper).unwrap(), family)
+        .unwrap();
+    restored.restore_state(state).unwrap();
+    let (xs, us) = (saved.predicted_states(), saved.planned_controls());
+    let chosen = |c: &eigenmpc::mpc::Controller<PlanarChain<2>, 2, 4>| -> Vec<usize> {
+        xs.iter()
+            .zip(us)
+            .map(|(x, u)| c.interval_substeps(x, u))
+            .collect()
+    };
+    let expected = chosen(&saved);
+    assert!(expected.iter().any(|&n| n > 1), "{expected:?}");
+    assert_eq!(chosen(&restored), expected);
+    for _ in 0..20 {
+        let (a, b) = (saved.step(&z), restored.step(&z));
+        assert_eq!(a.tau, b.tau);
+        z = simulate_accurate::<_, 2, 4>(&robot, &z, &a.tau, dt, tol).unwrap();
+    }
+}

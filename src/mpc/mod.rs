@@ -240,14 +240,21 @@ where
             }
             _ => {}
         }
-        self.steepest_friction_slope = linearise::steepest_friction_slope(&system);
-        self.system = system;
+        self.set_system(system);
         let old = std::mem::replace(&mut self.family, family);
         if let (Some(f), Some(chart)) = (&self.family, self.reference.chart_mut()) {
             f.write_chart(self.config.cost.e_ref, chart);
         }
         self.prepared = false;
         Ok(old)
+    }
+
+    /// The model, with what the per-sample path derives from it once (the
+    /// steepest friction slope the substeps are chosen against): every
+    /// change of the model goes through here.
+    fn set_system(&mut self, system: S) {
+        self.steepest_friction_slope = linearise::steepest_friction_slope(&system);
+        self.system = system;
     }
 
     /// Sets the RK4 substeps per shooting interval (a new model with other

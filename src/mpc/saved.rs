@@ -115,7 +115,7 @@ where
             .restore_warm_start(&state.solver)
             .map_err(MpcError::InvalidState)?;
         self.config = config;
-        self.system = state.system;
+        self.set_system(state.system);
         self.reference = state.reference;
         self.family = state.family;
         self.xs = state.xs;
