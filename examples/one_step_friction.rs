@@ -11,7 +11,7 @@
 //! full Jacobian or only the friction's block in its W matrix. First, its
 //! order on a smooth interval (the error falls 8x a halving of the step).
 //!
-//! Measured (README "Speed"): one Rosenbrock-W step predicts no better than
+//! Measured (the book, `docs/book/src/performance.md`): one Rosenbrock-W step predicts no better than
 //! one RK4 step; the substeps resolve the friction torque's flip at a stop,
 //! they do not merely keep RK4 stable.
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates docs/speed.md (README "Speed"): the per-sample times of
+# Regenerates docs/speed.md (the book's speed chapter, docs/book/src/performance.md, includes it): the per-sample times of
 # `bench_mpc` with the CPU they were measured on and same-run ratios (the
 # robots of robots/ first), the instruction counts per RTI sample
 # (callgrind), which do not depend on the machine, and the first sample's

@@ -27,6 +27,7 @@
 //! whose regressor carries too little is skipped, and the prior is never
 //! forgotten, so the estimate there stays at the prior.
 
+use crate::math;
 use crate::mechanics::{PlanarChain, PlanarChainParams, Vector};
 use nalgebra::{SMatrix, SVector};
 
@@ -284,9 +285,9 @@ pub fn energy_features<const N: usize, const NP: usize>(
     for j in 0..N {
         f[B::<N, NP>::a_index(j, j)] = 0.5 * w[j] * w[j];
         for l in j + 1..N {
-            f[B::<N, NP>::a_index(j, l)] = (phi_abs[j] - phi_abs[l]).cos() * w[j] * w[l];
+            f[B::<N, NP>::a_index(j, l)] = math::cos(phi_abs[j] - phi_abs[l]) * w[j] * w[l];
         }
-        f[B::<N, NP>::g_index(j)] = 1.0 - phi_abs[j].cos();
+        f[B::<N, NP>::g_index(j)] = 1.0 - math::cos(phi_abs[j]);
         let before: f64 = qd.iter().take(j).sum();
         let rotor = before - params.joints[j].gear_ratio * qd[j];
         f[B::<N, NP>::rotor_index(j)] = 0.5 * rotor * rotor;

@@ -2,6 +2,7 @@
 //! shooting map) and adaptive Dormand-Prince 5(4) (the plant and the orbit
 //! computations).
 
+use crate::math;
 use crate::mechanics::{
     DynamicsJacobian, MechanicalSystem, Vector, pack_state, state_derivative, state_jacobian,
     unpack_state,
@@ -409,7 +410,7 @@ impl<S: OdeState> Dopri5<S> {
         let h1 = if d1.max(d2) <= 1e-15 {
             (h0 * 1e-3).max(1e-6)
         } else {
-            (0.01 / d1.max(d2)).powf(0.2)
+            math::powf(0.01 / d1.max(d2), 0.2)
         };
         (100.0 * h0).min(h1).min(span.abs())
     }
@@ -488,7 +489,7 @@ impl<S: OdeState> Dopri5<S> {
             let factor = if en == 0.0 {
                 5.0
             } else {
-                (0.9 * en.powf(-0.2)).clamp(0.2, 5.0)
+                (0.9 * math::powf(en, -0.2)).clamp(0.2, 5.0)
             };
             if en <= 1.0 {
                 self.t = if last { t_end } else { t + hs };

@@ -10,6 +10,7 @@ use eigenmpc::identify::{
     friction_features,
 };
 use eigenmpc::integrate::{Dopri5, Tolerances};
+use eigenmpc::math;
 use eigenmpc::mechanics::{
     Joint, Link, MechanicalSystem, PlanarChain, PlanarChainParams, Vector, state_derivative,
 };
@@ -47,8 +48,8 @@ fn states<const N: usize>() -> Vec<(Vector<N>, Vector<N>)> {
         .map(|i| {
             let x = i as f64;
             (
-                Vector::<N>::from_fn(|j, _| (0.7 * x + j as f64).sin() * 1.5),
-                Vector::<N>::from_fn(|j, _| (1.3 * x - 2.0 * j as f64).cos() * 3.0),
+                Vector::<N>::from_fn(|j, _| math::sin(0.7 * x + j as f64) * 1.5),
+                Vector::<N>::from_fn(|j, _| math::cos(1.3 * x - 2.0 * j as f64) * 3.0),
             )
         })
         .collect()
@@ -169,8 +170,8 @@ fn recursive_least_squares_recovers_a_plant_the_prior_gets_wrong() {
     let prior = PlanarChainParams::<2>::default();
     let excite = |t: f64| {
         Vector::<2>::new(
-            0.8 * (1.7 * t).sin() + 0.3 * (5.1 * t).cos(),
-            0.6 * (2.9 * t).sin(),
+            0.8 * math::sin(1.7 * t) + 0.3 * math::cos(5.1 * t),
+            0.6 * math::sin(2.9 * t),
         )
     };
     let rls = identify(&plant, &prior, 60.0, excite);
@@ -257,8 +258,8 @@ fn identify_a0(noise: f64, seconds: f64) -> (EnergyBalanceRls<2, 11>, Vec<Window
         ));
         let t = k as f64 * dt;
         tau = Vector::<2>::new(
-            0.3 * (2.3 * t).sin() + 0.1 * (7.1 * t).cos(),
-            0.2 * (3.7 * t).sin(),
+            0.3 * math::sin(2.3 * t) + 0.1 * math::cos(7.1 * t),
+            0.2 * math::sin(3.7 * t),
         );
         ode.advance_to(
             |_, z| state_derivative::<_, 2, 4>(&system, z, &tau),

@@ -3,6 +3,7 @@
 //! Coriolis terms against the Christoffel symbols of M.
 
 use eigenmpc::integrate::{Dopri5, Tolerances, rk4_step, rk4_step_sensitivity};
+use eigenmpc::math;
 use eigenmpc::mechanics::{
     Conservative, DoublePendulum, Joint, Link, MechanicalSystem, PlanarChain, PlanarChainParams,
     Vector, state_derivative,
@@ -123,8 +124,8 @@ fn rigid_chain3() -> PlanarChain<3> {
 
 fn check_dynamics_jacobian<const N: usize, S: MechanicalSystem<N>>(sys: &S, points: &[[f64; 3]]) {
     for p in points {
-        let q = Vector::<N>::from_fn(|i, _| p[0] * (i as f64 + 1.0).sin() + 0.1 * i as f64);
-        let qd = Vector::<N>::from_fn(|i, _| p[1] * (2.0 * i as f64 + 0.5).cos());
+        let q = Vector::<N>::from_fn(|i, _| p[0] * math::sin(i as f64 + 1.0) + 0.1 * i as f64);
+        let qd = Vector::<N>::from_fn(|i, _| p[1] * math::cos(2.0 * i as f64 + 0.5));
         let tau = Vector::<N>::from_fn(|i, _| p[2] * (1.0 - 0.3 * i as f64));
         let jac = sys.dynamics_jacobian(&q, &qd, &tau);
         assert_close(
@@ -213,7 +214,7 @@ fn robot_mass_matrix_matches_the_published_model() {
     );
     for q2 in [0.0f64, 0.7, -2.1, 3.1] {
         let m = sys.mass_matrix(&Vector::<2>::new(0.4, q2));
-        let c2 = q2.cos();
+        let c2 = math::cos(q2);
         let m11 = i1 + i2 + m2 * l1 * l1 + 2.0 * m2 * l1 * r2 * c2 + gr * gr * ir + ir;
         let m12 = i2 + m2 * l1 * r2 * c2 - gr * ir;
         let m22 = i2 + gr * gr * ir;
@@ -223,14 +224,14 @@ fn robot_mass_matrix_matches_the_published_model() {
     }
     // V = -(m1 r1 + m2 l1) g cos q1 - m2 r2 g cos(q1 + q2) + const, V(0) = 0.
     let q = Vector::<2>::new(0.8, -1.3);
-    let v = -(0.5593806151425046 * 0.3 + m2 * l1) * 9.81 * (q[0].cos() - 1.0)
-        - m2 * r2 * 9.81 * ((q[0] + q[1]).cos() - 1.0);
+    let v = -(0.5593806151425046 * 0.3 + m2 * l1) * 9.81 * (math::cos(q[0]) - 1.0)
+        - m2 * r2 * 9.81 * (math::cos(q[0] + q[1]) - 1.0);
     assert!((sys.potential(&q) - v).abs() < 1e-14);
     // tau_f = b qd + cf atan(100 qd).
     let qd = Vector::<2>::new(0.02, -1.5);
     let f = sys.friction(&qd);
-    assert!((f[0] - (0.001 * 0.02 + 0.093 * 2.0f64.atan())).abs() < 1e-15);
-    assert!((f[1] - (0.001 * -1.5 + 0.078 * (-150.0f64).atan())).abs() < 1e-15);
+    assert!((f[0] - (0.001 * 0.02 + 0.093 * math::atan(2.0))).abs() < 1e-15);
+    assert!((f[1] - (0.001 * -1.5 + 0.078 * math::atan(-150.0f64))).abs() < 1e-15);
 }
 
 /// A rigid link with the inertia of a point mass is the paper's point-mass

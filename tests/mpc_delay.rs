@@ -8,6 +8,7 @@
 //! the table of docs/delay.md.
 
 use eigenmpc::integrate::{Dopri5, Tolerances};
+use eigenmpc::math;
 use eigenmpc::mechanics::{PlanarChain, PlanarChainParams, Vector, state_derivative};
 use eigenmpc::mpc::closed_loop::{energy_tail, reference_for, summarise};
 use eigenmpc::mpc::{Controller, EstimatorConfig, MpcConfig, MpcError, Variant};
@@ -40,7 +41,7 @@ fn responsiveness(lag_samples: f64) -> f64 {
     if lag_samples == 0.0 {
         1.0
     } else {
-        1.0 - (-1.0 / lag_samples).exp()
+        1.0 - math::exp(-1.0 / lag_samples)
     }
 }
 
@@ -276,7 +277,7 @@ fn applied_torque(t: f64, sent: &[Vector<2>], lag: f64) -> Vector<2> {
         if lag == 0.0 {
             a = *u;
         } else {
-            a = u + (a - u) * (-(t - start).min(DT) / lag).exp();
+            a = u + (a - u) * math::exp(-(t - start).min(DT) / lag);
         }
         if t <= start + DT {
             return a;
@@ -378,9 +379,9 @@ fn forward_prediction_is_the_model_over_the_delay() {
                 let start = (j as f64 - 8.0) * DT;
                 let end = start + DT;
                 if t <= end {
-                    return u + (a - u) * (-(t - start) / lag).exp();
+                    return u + (a - u) * math::exp(-(t - start) / lag);
                 }
-                a = u + (a - u) * (-DT / lag).exp();
+                a = u + (a - u) * math::exp(-DT / lag);
             }
             a
         };

@@ -2,6 +2,7 @@
 //! energy: a tuned E_ref is followed along the eigenmanifold, friction is
 //! compensated (the torque is what friction takes along the final orbit).
 
+use eigenmpc::math;
 use eigenmpc::mechanics::{DoublePendulum, MechanicalSystem, Vector};
 use eigenmpc::model_file::RobotFile;
 use eigenmpc::modes::{Chart, ChartFamily, ContinuationOptions, FamilyOptions, eigenmode_family};
@@ -108,13 +109,13 @@ fn friction_compensating_residual_jacobians_match_finite_differences() {
             let scale = match variant {
                 Variant::Curved => 1.0,
                 Variant::Straight | Variant::Hybrid => {
-                    (p.alpha
-                        * sys.energy(
-                            &z.fixed_rows::<2>(0).into_owned(),
-                            &z.fixed_rows::<2>(2).into_owned(),
-                        ))
-                    .tanh()
-                        + p.beta
+                    math::tanh(
+                        p.alpha
+                            * sys.energy(
+                                &z.fixed_rows::<2>(0).into_owned(),
+                                &z.fixed_rows::<2>(2).into_owned(),
+                            ),
+                    ) + p.beta
                 }
             };
             assert!((r.torque - (tau - f) * scale).amax() < 1e-14);

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The project's test command (README "Run the tests"): formatting, lints,
+# The project's test command (README "Two commands", docs/book/src/tests.md): formatting, lints,
 # Rust tests, FMU packaging, Python tests of the FMUs (fmpy, libcosim).
 # Installs what a fresh Debian machine lacks.
 set -euo pipefail
@@ -11,11 +11,26 @@ cd "$(dirname "$0")/.."
 source scripts/ensure-build-deps.sh
 source scripts/ensure-cross-deps.sh
 
+# A build, the demo and the tests write nothing git tracks (issue 36): the
+# tree's state (changes and untracked files) now, compared after each step
+# that builds or runs something (so a developer's uncommitted work is fine,
+# a file the run rewrites is not).
+tree_state() { { git status --porcelain=v1 -uall; git diff; } | sha256sum; }
+tree_at_start=$(tree_state)
+assert_tree_unchanged() {
+    if [ "$(tree_state)" != "$tree_at_start" ]; then
+        echo "$1 changed files git tracks, or left files git does not ignore:" >&2
+        git status --short >&2
+        git diff --stat >&2
+        exit 1
+    fi
+}
+
 echo "== [${SECONDS} s] cargo fmt --check"
 cargo fmt --all -- --check
 echo "== [${SECONDS} s] cargo clippy"
 cargo clippy --workspace --all-targets -- -D warnings
-echo "== [${SECONDS} s] the FMUs link only what they run (cargo tree; README \"What each FMU links\")"
+echo "== [${SECONDS} s] the FMUs link only what they run (cargo tree; docs/book/src/fmus.md \"What each FMU links\")"
 fmu_links() { cargo tree -p "$1" -e normal,build --prefix none | awk '{print $1}' | sort -u; }
 # The one FMU binary (every shipped and exported FMU) and the C library.
 for p in eigenmpc-robot-fmu eigenmpc-fmu; do
@@ -25,6 +40,15 @@ for p in eigenmpc-robot-fmu eigenmpc-fmu; do
         exit 1
     fi
 done
+echo "== [${SECONDS} s] no kernel chosen by the CPU at run time in the numerics (nalgebra without std: no matrixmultiply)"
+# nalgebra's std feature brings matrixmultiply (FMA / AVX / SSE2 / NEON
+# kernels picked at run time) and the platform's libm into every dynamic
+# matrix product and SVD: the same source would give other bits elsewhere.
+if cargo tree --workspace -e normal,build,dev --prefix none | grep -q '^matrixmultiply '; then
+    echo "matrixmultiply is back in the build: something enabled nalgebra's std feature" >&2
+    cargo tree --workspace -e features -i nalgebra >&2
+    exit 1
+fi
 echo "== [${SECONDS} s] cargo test"
 cargo test --workspace
 # fmu-build, the demo and the CLI in one cargo invocation: one feature set
@@ -37,13 +61,17 @@ cargo build --release -p fmu-build -p eigenmpc-demo -p eigenmpc-cli
 release_dir="${CARGO_TARGET_DIR:-target}/release"
 echo "== [${SECONDS} s] fmu-build (the FMU binary for linux64, win64 and aarch64-linux, target/fmu/*.fmu and fmi3/*.fmu, the C library, include/eigenmpc.h)"
 "$release_dir/fmu-build"
+assert_tree_unchanged "fmu-build"
+
+echo "== [${SECONDS} s] the same bits on every machine: the shipped descriptions natively, on baseline and AVX2 x86-64 and on aarch64 (tests/same_bits.sh)"
+bash tests/same_bits.sh
 
 echo "== [${SECONDS} s] demo (the main job, on the FMUs just built): controller FMU drives plant FMU"
 bash demo/run.sh --no-build --out-dir target/demo-ci
 for f in demo.csv demo.png demo.svg; do
     test -s "target/demo-ci/$f" || { echo "demo did not write target/demo-ci/$f" >&2; exit 1; }
 done
-# The README's two other demo runs: a robot parameter file, 3 links. Each
+# The book's two other demo runs (docs/book/src/demo.md): a robot parameter file, 3 links. Each
 # must bring the energy into the 5 % band.
 demo_reaches_band() {
     local out
@@ -61,6 +89,8 @@ if bash demo/run.sh --no-build --links 4 --out-dir target/demo-ci-4 2>/dev/null;
     echo "demo --links 4 should be refused" >&2
     exit 1
 fi
+
+assert_tree_unchanged "the demo"
 
 echo "== [${SECONDS} s] C host tests (include/eigenmpc.h; linux64 with gcc, win64 with mingw under wine, aarch64-linux under qemu-user)"
 bash tests/c/hosts.sh
@@ -112,3 +142,12 @@ echo "== [${SECONDS} s] pytest"
 .venv/bin/python -m pytest tests/python -rs
 echo "== [${SECONDS} s] pytest python/ (the Dask sweep runner against the native sweep)"
 .venv/bin/python -m pytest python/tests -rs
+
+echo "== [${SECONDS} s] the book (docs/book, mdbook; no broken internal link) and the API docs (cargo doc, warnings denied)"
+bash scripts/book.sh
+echo "== [${SECONDS} s] the README's commands, as written (tests/readme_commands.sh)"
+bash tests/readme_commands.sh
+echo "== [${SECONDS} s] the library crates package (scripts/package.sh)"
+bash scripts/package.sh
+assert_tree_unchanged "the tests"
+echo "== [${SECONDS} s] done"

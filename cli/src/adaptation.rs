@@ -288,7 +288,8 @@ const GREEN: RGBColor = RGBColor(44, 160, 44);
 /// Tick labels with as many decimals as the axis `span` needs (the base
 /// parameters range from 1e-5 kg m² rotor inertias to 20 N m), never `-0`.
 fn tick(v: f64, span: f64) -> String {
-    let decimals = (2.0 - span.abs().max(1e-12).log10().floor()).clamp(0.0, 9.0) as usize;
+    let decimals =
+        (2.0 - eigenmpc::math::log10(span.abs().max(1e-12)).floor()).clamp(0.0, 9.0) as usize;
     let text = format!("{v:.decimals$}");
     let text = if text.contains('.') {
         text.trim_end_matches('0').trim_end_matches('.').to_string()

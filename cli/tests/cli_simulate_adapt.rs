@@ -105,7 +105,7 @@ fn adaptation_finds_the_lighter_plant_and_plots_it() {
     assert_eq!(value(last, "adapt_reverts"), 0.0, "{last:?}");
     assert_eq!(last[col("adaptation_status")], "converged", "{last:?}");
     // With the model taken the plant's energy is held at E_ref (without
-    // adaptation it ends 17 % low: README, "A wrong model").
+    // adaptation it ends 17 % low: docs/book/src/adaptation.md).
     let energy: Vec<f64> = rows[rows.len() - 200..]
         .iter()
         .map(|r| value(r, "energy"))

@@ -80,7 +80,7 @@ metric = "time_to_band"
     let col = |name: &str| rows[0].iter().position(|c| c == name).unwrap();
     let (band, success) = (col("time_to_band"), col("success"));
     // E_ref = 14 J without delay is `eigenmpc simulate`'s default run: the
-    // band at 19.675 s (README, demo).
+    // band at 19.675 s (docs/book/src/demo.md).
     let row = rows
         .iter()
         .find(|r| r[1] == "14" && r[2] == "0")

@@ -457,7 +457,7 @@ unsafe fn finish_create(
 /// parameters and defaults, 3: `EigenMPC3`'s, others: an exported robot's,
 /// whose chart is computed from the model) from parameter names and values: `count` pairs
 /// `names[i]` = `values[i]`, any parameter of that FMU's variable table
-/// (README, "FMI co-simulation FMUs"): the model (`m[j]`, `l[j]`, `g`,
+/// (the book, `docs/book/src/fmu-variables.md`): the model (`m[j]`, `l[j]`, `g`,
 /// `r[j]`, `I[j]`, `Ir[j]`, `gr[j]`, `b[j]`, `cf[j]`, `k[j]`, `q_rest[j]`,
 /// `coulomb_sharpness`), the tuning (`E_ref`, `w_E`, ...), `variant`,
 /// `qp_solver`, `horizon`, `chart_source`, `mode`, `c[j]`,

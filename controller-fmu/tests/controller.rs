@@ -871,7 +871,7 @@ fn checked_in_model_description_matches_the_table() {
     let checked_in = std::fs::read_to_string(&path).unwrap_or_default();
     assert!(
         checked_in == generated,
-        "{} is out of date with the variable table: run `cargo run -p fmu-build` and commit it",
+        "{} is out of date with the variable table: run `cargo run --release -p fmu-build -- --update-checked-in` and commit it",
         path.display()
     );
 }

@@ -52,7 +52,7 @@ struct Args {
     /// Simulated time (s; default 30 for 2 links, 60 for 3).
     #[arg(long)]
     duration: Option<f64>,
-    /// Initial joint angles q1,q2[,q3] (rad), at rest (default 0.05 each).
+    /// Initial joint angles `q1,q2[,q3]` (rad), at rest (default 0.05 each).
     #[arg(long, allow_hyphen_values = true)]
     q0: Option<String>,
     /// Number of links: 2 (EigenMPC.fmu, DoublePendulum.fmu) or 3
@@ -65,7 +65,7 @@ struct Args {
     #[arg(long)]
     model: Option<PathBuf>,
     /// Torque bound |tau_j| <= tau_max (N m; default 1, or less where the
-    /// model file's motor limits tl<j> are lower).
+    /// model file's motor limits `tl<j>` are lower).
     #[arg(long)]
     tau_max: Option<f64>,
 }
@@ -141,16 +141,36 @@ impl Slave {
 
 /// Builds the FMUs with fmu-build: for the host's platform only (the demo
 /// runs there) unless `FMU_PLATFORMS` says otherwise; `tests/run.sh`
-/// builds every platform.
+/// builds every platform. fmu-build is built together with the demo and the
+/// CLI, as `tests/run.sh` builds them: one feature set for the shared
+/// crates, so nothing is compiled twice (`cargo run -p fmu-build` alone
+/// would resolve other features of syn, typenum, ... and rebuild most of
+/// the workspace).
 fn build_fmus() -> Result<()> {
     use fmu_build::platform::PLATFORMS_ENV;
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let platforms = std::env::var(PLATFORMS_ENV).unwrap_or_else(|_| "linux64".into());
     let status = Command::new(cargo)
-        .args(["run", "--quiet", "--release", "-p", "fmu-build"])
+        .args(["build", "--quiet", "--release"])
+        .args([
+            "-p",
+            "fmu-build",
+            "-p",
+            "eigenmpc-demo",
+            "-p",
+            "eigenmpc-cli",
+        ])
+        .status()
+        .context("building fmu-build")?;
+    if !status.success() {
+        bail!("building fmu-build failed ({status})");
+    }
+    let exe = std::env::current_exe().context("locating the demo's executable")?;
+    let fmu_build = exe.with_file_name(format!("fmu-build{}", std::env::consts::EXE_SUFFIX));
+    let status = Command::new(&fmu_build)
         .env(PLATFORMS_ENV, platforms)
         .status()
-        .context("running fmu-build")?;
+        .with_context(|| format!("running {}", fmu_build.display()))?;
     if !status.success() {
         bail!("fmu-build failed ({status})");
     }
@@ -357,7 +377,7 @@ fn co_simulate<const N: usize, const NX: usize>(
         }
         // The controller solves at the communication point t with the inputs
         // just set; its torque is the output when doStep returns, held over
-        // [t, t + h] (see README, "Timing").
+        // [t, t + h] (see docs/book/src/fmu-variables.md, "Timing").
         controller.step(t, h)?;
         controller.get(&ctrl_out, &mut out)?;
         let mut diag = [0; 2];

@@ -118,7 +118,7 @@ pub unsafe fn free_instance<M: Model>(c: ffi::fmi2Component) {
 /// `fmi2SetDebugLogging`.
 ///
 /// # Safety
-/// `c` as for [`call`]; `categories` null or `n` NUL-terminated strings.
+/// `c` as for `call`; `categories` null or `n` NUL-terminated strings.
 pub unsafe fn set_debug_logging<M: Model>(
     c: ffi::fmi2Component,
     logging_on: ffi::fmi2Boolean,
@@ -147,7 +147,7 @@ pub unsafe fn set_debug_logging<M: Model>(
 /// `fmi2SetupExperiment`.
 ///
 /// # Safety
-/// `c` as for [`call`].
+/// `c` as for `call`.
 pub unsafe fn setup_experiment<M: Model>(
     c: ffi::fmi2Component,
     tolerance_defined: ffi::fmi2Boolean,
@@ -170,7 +170,7 @@ pub unsafe fn setup_experiment<M: Model>(
 /// `fmi2EnterInitializationMode`.
 ///
 /// # Safety
-/// `c` as for [`call`].
+/// `c` as for `call`.
 pub unsafe fn enter_initialization_mode<M: Model>(c: ffi::fmi2Component) -> ffi::fmi2Status {
     unsafe {
         call::<M>(c, "fmi2EnterInitializationMode", |inst| {
@@ -182,7 +182,7 @@ pub unsafe fn enter_initialization_mode<M: Model>(c: ffi::fmi2Component) -> ffi:
 /// `fmi2ExitInitializationMode`.
 ///
 /// # Safety
-/// `c` as for [`call`].
+/// `c` as for `call`.
 pub unsafe fn exit_initialization_mode<M: Model>(c: ffi::fmi2Component) -> ffi::fmi2Status {
     unsafe {
         call::<M>(c, "fmi2ExitInitializationMode", |inst| {
@@ -194,7 +194,7 @@ pub unsafe fn exit_initialization_mode<M: Model>(c: ffi::fmi2Component) -> ffi::
 /// `fmi2Terminate`.
 ///
 /// # Safety
-/// `c` as for [`call`].
+/// `c` as for `call`.
 pub unsafe fn terminate<M: Model>(c: ffi::fmi2Component) -> ffi::fmi2Status {
     unsafe { call::<M>(c, "fmi2Terminate", |inst| inst.terminate()) }
 }
@@ -202,7 +202,7 @@ pub unsafe fn terminate<M: Model>(c: ffi::fmi2Component) -> ffi::fmi2Status {
 /// `fmi2Reset`.
 ///
 /// # Safety
-/// `c` as for [`call`].
+/// `c` as for `call`.
 pub unsafe fn reset<M: Model>(c: ffi::fmi2Component) -> ffi::fmi2Status {
     unsafe { call::<M>(c, "fmi2Reset", |inst| inst.reset()) }
 }
@@ -210,7 +210,7 @@ pub unsafe fn reset<M: Model>(c: ffi::fmi2Component) -> ffi::fmi2Status {
 /// `fmi2GetReal`.
 ///
 /// # Safety
-/// `c` as for [`call`]; `vr` and `value` null or arrays of `n` elements.
+/// `c` as for `call`; `vr` and `value` null or arrays of `n` elements.
 pub unsafe fn get_real<M: Model>(
     c: ffi::fmi2Component,
     vr: *const ffi::fmi2ValueReference,
@@ -230,7 +230,7 @@ pub unsafe fn get_real<M: Model>(
 /// `fmi2SetReal`.
 ///
 /// # Safety
-/// `c` as for [`call`]; `vr` and `value` null or arrays of `n` elements.
+/// `c` as for `call`; `vr` and `value` null or arrays of `n` elements.
 pub unsafe fn set_real<M: Model>(
     c: ffi::fmi2Component,
     vr: *const ffi::fmi2ValueReference,
@@ -250,7 +250,7 @@ pub unsafe fn set_real<M: Model>(
 /// `fmi2GetInteger`.
 ///
 /// # Safety
-/// `c` as for [`call`]; `vr` and `value` null or arrays of `n` elements.
+/// `c` as for `call`; `vr` and `value` null or arrays of `n` elements.
 pub unsafe fn get_integer<M: Model>(
     c: ffi::fmi2Component,
     vr: *const ffi::fmi2ValueReference,
@@ -270,7 +270,7 @@ pub unsafe fn get_integer<M: Model>(
 /// `fmi2SetInteger`.
 ///
 /// # Safety
-/// `c` as for [`call`]; `vr` and `value` null or arrays of `n` elements.
+/// `c` as for `call`; `vr` and `value` null or arrays of `n` elements.
 pub unsafe fn set_integer<M: Model>(
     c: ffi::fmi2Component,
     vr: *const ffi::fmi2ValueReference,
@@ -290,7 +290,7 @@ pub unsafe fn set_integer<M: Model>(
 /// `fmi2GetBoolean` (C booleans are `int`: written as 0/1).
 ///
 /// # Safety
-/// `c` as for [`call`]; `vr` and `value` null or arrays of `n` elements.
+/// `c` as for `call`; `vr` and `value` null or arrays of `n` elements.
 pub unsafe fn get_boolean<M: Model>(
     c: ffi::fmi2Component,
     vr: *const ffi::fmi2ValueReference,
@@ -314,7 +314,7 @@ pub unsafe fn get_boolean<M: Model>(
 /// `fmi2SetBoolean` (any non-zero C value is true).
 ///
 /// # Safety
-/// `c` as for [`call`]; `vr` and `value` null or arrays of `n` elements.
+/// `c` as for `call`; `vr` and `value` null or arrays of `n` elements.
 pub unsafe fn set_boolean<M: Model>(
     c: ffi::fmi2Component,
     vr: *const ffi::fmi2ValueReference,
@@ -336,7 +336,7 @@ pub unsafe fn set_boolean<M: Model>(
 /// `fmi2GetString`.
 ///
 /// # Safety
-/// `c` as for [`call`]; `vr` null or an array of `n` elements.
+/// `c` as for `call`; `vr` null or an array of `n` elements.
 pub unsafe fn get_string<M: Model>(
     c: ffi::fmi2Component,
     vr: *const ffi::fmi2ValueReference,
@@ -356,7 +356,7 @@ pub unsafe fn get_string<M: Model>(
 /// `fmi2SetString`.
 ///
 /// # Safety
-/// `c` as for [`call`]; `vr` null or an array of `n` elements.
+/// `c` as for `call`; `vr` null or an array of `n` elements.
 pub unsafe fn set_string<M: Model>(
     c: ffi::fmi2Component,
     vr: *const ffi::fmi2ValueReference,
@@ -376,7 +376,7 @@ pub unsafe fn set_string<M: Model>(
 /// Any function this FMU does not implement: `fmi2Error` with a log line.
 ///
 /// # Safety
-/// `c` as for [`call`].
+/// `c` as for `call`.
 pub unsafe fn unsupported<M: Model>(
     c: ffi::fmi2Component,
     func: &'static str,
@@ -390,7 +390,7 @@ pub unsafe fn unsupported<M: Model>(
 /// warning line, the instance stays usable; a NULL `value` is an error.
 ///
 /// # Safety
-/// `c` as for [`call`].
+/// `c` as for `call`.
 pub unsafe fn status_unavailable<M: Model>(
     c: ffi::fmi2Component,
     func: &'static str,
@@ -411,7 +411,7 @@ pub unsafe fn status_unavailable<M: Model>(
 /// `fmi2DoStep`.
 ///
 /// # Safety
-/// `c` as for [`call`].
+/// `c` as for `call`.
 pub unsafe fn do_step<M: Model>(
     c: ffi::fmi2Component,
     t: ffi::fmi2Real,
@@ -424,7 +424,7 @@ pub unsafe fn do_step<M: Model>(
 /// `fmi2GetRealStatus`: only `fmi2LastSuccessfulTime`.
 ///
 /// # Safety
-/// `c` as for [`call`]; `value` null or writable.
+/// `c` as for `call`; `value` null or writable.
 pub unsafe fn get_real_status<M: Model>(
     c: ffi::fmi2Component,
     kind: ffi::fmi2StatusKind,
@@ -453,7 +453,7 @@ pub unsafe fn get_real_status<M: Model>(
 /// `fmi2GetBooleanStatus`: only `fmi2Terminated`.
 ///
 /// # Safety
-/// `c` as for [`call`]; `value` null or writable.
+/// `c` as for `call`; `value` null or writable.
 pub unsafe fn get_boolean_status<M: Model>(
     c: ffi::fmi2Component,
     kind: ffi::fmi2StatusKind,
@@ -485,7 +485,7 @@ const STATE: &str = "FMUstate";
 /// `fmi2GetFMUstate`.
 ///
 /// # Safety
-/// `c` as for [`call`]; `s` null or writable.
+/// `c` as for `call`; `s` null or writable.
 pub unsafe fn get_fmu_state<M: Model>(
     c: ffi::fmi2Component,
     s: *mut ffi::fmi2FMUstate,
@@ -510,7 +510,7 @@ pub unsafe fn get_fmu_state<M: Model>(
 /// `fmi2SetFMUstate`.
 ///
 /// # Safety
-/// `c` as for [`call`].
+/// `c` as for `call`.
 pub unsafe fn set_fmu_state<M: Model>(
     c: ffi::fmi2Component,
     s: ffi::fmi2FMUstate,
@@ -530,7 +530,7 @@ pub unsafe fn set_fmu_state<M: Model>(
 /// `fmi2FreeFMUstate`: frees `*s` and sets it to NULL (`*s == NULL`: nothing).
 ///
 /// # Safety
-/// `c` as for [`call`]; `s` null or writable.
+/// `c` as for `call`; `s` null or writable.
 pub unsafe fn free_fmu_state<M: Model>(
     c: ffi::fmi2Component,
     s: *mut ffi::fmi2FMUstate,
@@ -560,7 +560,7 @@ pub unsafe fn free_fmu_state<M: Model>(
 /// `fmi2SerializedFMUstateSize`.
 ///
 /// # Safety
-/// `c` as for [`call`]; `size` null or writable.
+/// `c` as for `call`; `size` null or writable.
 pub unsafe fn serialized_fmu_state_size<M: Model>(
     c: ffi::fmi2Component,
     s: ffi::fmi2FMUstate,
@@ -587,7 +587,7 @@ pub unsafe fn serialized_fmu_state_size<M: Model>(
 /// must be at least [`serialized_fmu_state_size`]'s.
 ///
 /// # Safety
-/// `c` as for [`call`]; `bytes` null or `size` writable bytes.
+/// `c` as for `call`; `bytes` null or `size` writable bytes.
 pub unsafe fn serialize_fmu_state<M: Model>(
     c: ffi::fmi2Component,
     s: ffi::fmi2FMUstate,
@@ -621,7 +621,7 @@ pub unsafe fn serialize_fmu_state<M: Model>(
 /// `bytes[..size]`, checked before anything is stored.
 ///
 /// # Safety
-/// `c` as for [`call`]; `bytes` null or `size` readable bytes; `s` null or writable.
+/// `c` as for `call`; `bytes` null or `size` readable bytes; `s` null or writable.
 pub unsafe fn deserialize_fmu_state<M: Model>(
     c: ffi::fmi2Component,
     bytes: *const ffi::fmi2Byte,

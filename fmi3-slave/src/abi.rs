@@ -182,7 +182,7 @@ pub unsafe fn free_instance<M: Model>(c: ffi::fmi3Instance) {
 /// `fmi3SetDebugLogging`.
 ///
 /// # Safety
-/// `c` as for [`call`]; `categories` null or `n` NUL-terminated strings.
+/// `c` as for `call`; `categories` null or `n` NUL-terminated strings.
 pub unsafe fn set_debug_logging<M: Model>(
     c: ffi::fmi3Instance,
     logging_on: ffi::fmi3Boolean,
@@ -211,7 +211,7 @@ pub unsafe fn set_debug_logging<M: Model>(
 /// `fmi3EnterInitializationMode`.
 ///
 /// # Safety
-/// `c` as for [`call`].
+/// `c` as for `call`.
 pub unsafe fn enter_initialization_mode<M: Model>(
     c: ffi::fmi3Instance,
     tolerance_defined: ffi::fmi3Boolean,
@@ -234,7 +234,7 @@ pub unsafe fn enter_initialization_mode<M: Model>(
 /// `fmi3ExitInitializationMode`.
 ///
 /// # Safety
-/// `c` as for [`call`].
+/// `c` as for `call`.
 pub unsafe fn exit_initialization_mode<M: Model>(c: ffi::fmi3Instance) -> ffi::fmi3Status {
     unsafe {
         call::<M>(c, "fmi3ExitInitializationMode", |inst| {
@@ -246,7 +246,7 @@ pub unsafe fn exit_initialization_mode<M: Model>(c: ffi::fmi3Instance) -> ffi::f
 /// `fmi3Terminate`.
 ///
 /// # Safety
-/// `c` as for [`call`].
+/// `c` as for `call`.
 pub unsafe fn terminate<M: Model>(c: ffi::fmi3Instance) -> ffi::fmi3Status {
     unsafe { call::<M>(c, "fmi3Terminate", |inst| inst.terminate()) }
 }
@@ -254,7 +254,7 @@ pub unsafe fn terminate<M: Model>(c: ffi::fmi3Instance) -> ffi::fmi3Status {
 /// `fmi3Reset`.
 ///
 /// # Safety
-/// `c` as for [`call`].
+/// `c` as for `call`.
 pub unsafe fn reset<M: Model>(c: ffi::fmi3Instance) -> ffi::fmi3Status {
     unsafe { call::<M>(c, "fmi3Reset", |inst| inst.reset()) }
 }
@@ -262,7 +262,7 @@ pub unsafe fn reset<M: Model>(c: ffi::fmi3Instance) -> ffi::fmi3Status {
 /// A typed getter: `convert` turns each value into the C type.
 ///
 /// # Safety
-/// `c` as for [`call`]; `vr` null or `nvr` elements, `values` null or
+/// `c` as for `call`; `vr` null or `nvr` elements, `values` null or
 /// `n_values` writable elements.
 #[allow(clippy::too_many_arguments)]
 unsafe fn getter<M: Model, T>(
@@ -292,7 +292,7 @@ unsafe fn getter<M: Model, T>(
 /// one the variable's type cannot hold).
 ///
 /// # Safety
-/// `c` as for [`call`]; `vr` null or `nvr` elements, `values` null or
+/// `c` as for `call`; `vr` null or `nvr` elements, `values` null or
 /// `n_values` elements.
 #[allow(clippy::too_many_arguments)]
 unsafe fn setter<M: Model, T: Copy>(
@@ -319,7 +319,7 @@ unsafe fn setter<M: Model, T: Copy>(
 /// `fmi3GetFloat64` (arrays in row-major order; `nValues` counts elements).
 ///
 /// # Safety
-/// `c` as for [`call`]; arrays as the FMI 3.0 standard defines them.
+/// `c` as for `call`; arrays as the FMI 3.0 standard defines them.
 pub unsafe fn get_float64<M: Model>(
     c: ffi::fmi3Instance,
     vr: *const ffi::fmi3ValueReference,
@@ -347,7 +347,7 @@ pub unsafe fn get_float64<M: Model>(
 /// `fmi3SetFloat64` (NaN, infinities and values outside min/max refused).
 ///
 /// # Safety
-/// `c` as for [`call`]; arrays as the FMI 3.0 standard defines them.
+/// `c` as for `call`; arrays as the FMI 3.0 standard defines them.
 pub unsafe fn set_float64<M: Model>(
     c: ffi::fmi3Instance,
     vr: *const ffi::fmi3ValueReference,
@@ -372,7 +372,7 @@ pub unsafe fn set_float64<M: Model>(
 /// `fmi3GetInt32`.
 ///
 /// # Safety
-/// `c` as for [`call`]; arrays as the FMI 3.0 standard defines them.
+/// `c` as for `call`; arrays as the FMI 3.0 standard defines them.
 pub unsafe fn get_int32<M: Model>(
     c: ffi::fmi3Instance,
     vr: *const ffi::fmi3ValueReference,
@@ -400,7 +400,7 @@ pub unsafe fn get_int32<M: Model>(
 /// `fmi3SetInt32`.
 ///
 /// # Safety
-/// `c` as for [`call`]; arrays as the FMI 3.0 standard defines them.
+/// `c` as for `call`; arrays as the FMI 3.0 standard defines them.
 pub unsafe fn set_int32<M: Model>(
     c: ffi::fmi3Instance,
     vr: *const ffi::fmi3ValueReference,
@@ -425,7 +425,7 @@ pub unsafe fn set_int32<M: Model>(
 /// `fmi3GetInt64`: the enumerations (FMI 3.0 accesses them as Int64).
 ///
 /// # Safety
-/// `c` as for [`call`]; arrays as the FMI 3.0 standard defines them.
+/// `c` as for `call`; arrays as the FMI 3.0 standard defines them.
 pub unsafe fn get_int64<M: Model>(
     c: ffi::fmi3Instance,
     vr: *const ffi::fmi3ValueReference,
@@ -454,7 +454,7 @@ pub unsafe fn get_int64<M: Model>(
 /// refused).
 ///
 /// # Safety
-/// `c` as for [`call`]; arrays as the FMI 3.0 standard defines them.
+/// `c` as for `call`; arrays as the FMI 3.0 standard defines them.
 pub unsafe fn set_int64<M: Model>(
     c: ffi::fmi3Instance,
     vr: *const ffi::fmi3ValueReference,
@@ -483,7 +483,7 @@ pub unsafe fn set_int64<M: Model>(
 /// `fmi3GetBoolean`.
 ///
 /// # Safety
-/// `c` as for [`call`]; arrays as the FMI 3.0 standard defines them.
+/// `c` as for `call`; arrays as the FMI 3.0 standard defines them.
 pub unsafe fn get_boolean<M: Model>(
     c: ffi::fmi3Instance,
     vr: *const ffi::fmi3ValueReference,
@@ -510,7 +510,7 @@ pub unsafe fn get_boolean<M: Model>(
 /// undefined behaviour here.
 ///
 /// # Safety
-/// `c` as for [`call`]; arrays as the FMI 3.0 standard defines them.
+/// `c` as for `call`; arrays as the FMI 3.0 standard defines them.
 pub unsafe fn set_boolean<M: Model>(
     c: ffi::fmi3Instance,
     vr: *const ffi::fmi3ValueReference,
@@ -538,7 +538,7 @@ pub unsafe fn set_boolean<M: Model>(
 /// values pointer is NULL while values are expected.
 ///
 /// # Safety
-/// `c` as for [`call`]; `vr` null or `nvr` elements.
+/// `c` as for `call`; `vr` null or `nvr` elements.
 pub unsafe fn other_type<M: Model>(
     c: ffi::fmi3Instance,
     func: &'static str,
@@ -560,7 +560,7 @@ pub unsafe fn other_type<M: Model>(
 /// Any function this FMU does not implement: `fmi3Error` with a log line.
 ///
 /// # Safety
-/// `c` as for [`call`].
+/// `c` as for `call`.
 pub unsafe fn unsupported<M: Model>(
     c: ffi::fmi3Instance,
     func: &'static str,
@@ -574,7 +574,7 @@ pub unsafe fn unsupported<M: Model>(
 /// `lastSuccessfulTime`; all four pointers are required.
 ///
 /// # Safety
-/// `c` as for [`call`]; the output pointers null or writable.
+/// `c` as for `call`; the output pointers null or writable.
 #[allow(clippy::too_many_arguments)]
 pub unsafe fn do_step<M: Model>(
     c: ffi::fmi3Instance,
@@ -615,7 +615,7 @@ const STATE: &str = "FMUState";
 /// `fmi3GetFMUState`.
 ///
 /// # Safety
-/// `c` as for [`call`]; `s` null or writable.
+/// `c` as for `call`; `s` null or writable.
 pub unsafe fn get_fmu_state<M: Model>(
     c: ffi::fmi3Instance,
     s: *mut ffi::fmi3FMUState,
@@ -640,7 +640,7 @@ pub unsafe fn get_fmu_state<M: Model>(
 /// `fmi3SetFMUState`.
 ///
 /// # Safety
-/// `c` as for [`call`].
+/// `c` as for `call`.
 pub unsafe fn set_fmu_state<M: Model>(
     c: ffi::fmi3Instance,
     s: ffi::fmi3FMUState,
@@ -660,7 +660,7 @@ pub unsafe fn set_fmu_state<M: Model>(
 /// `fmi3FreeFMUState`: frees `*s` and sets it to NULL (`*s == NULL`: nothing).
 ///
 /// # Safety
-/// `c` as for [`call`]; `s` null or writable.
+/// `c` as for `call`; `s` null or writable.
 pub unsafe fn free_fmu_state<M: Model>(
     c: ffi::fmi3Instance,
     s: *mut ffi::fmi3FMUState,
@@ -690,7 +690,7 @@ pub unsafe fn free_fmu_state<M: Model>(
 /// `fmi3SerializedFMUStateSize`.
 ///
 /// # Safety
-/// `c` as for [`call`]; `size` null or writable.
+/// `c` as for `call`; `size` null or writable.
 pub unsafe fn serialized_fmu_state_size<M: Model>(
     c: ffi::fmi3Instance,
     s: ffi::fmi3FMUState,
@@ -717,7 +717,7 @@ pub unsafe fn serialized_fmu_state_size<M: Model>(
 /// must be at least [`serialized_fmu_state_size`]'s.
 ///
 /// # Safety
-/// `c` as for [`call`]; `bytes` null or `size` writable bytes.
+/// `c` as for `call`; `bytes` null or `size` writable bytes.
 pub unsafe fn serialize_fmu_state<M: Model>(
     c: ffi::fmi3Instance,
     s: ffi::fmi3FMUState,
@@ -751,7 +751,7 @@ pub unsafe fn serialize_fmu_state<M: Model>(
 /// `bytes[..size]`, checked before anything is stored.
 ///
 /// # Safety
-/// `c` as for [`call`]; `bytes` null or `size` readable bytes; `s` null or writable.
+/// `c` as for `call`; `bytes` null or `size` readable bytes; `s` null or writable.
 pub unsafe fn deserialize_fmu_state<M: Model>(
     c: ffi::fmi3Instance,
     bytes: *const ffi::fmi3Byte,

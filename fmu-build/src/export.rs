@@ -87,30 +87,10 @@ pub fn export<const N: usize, const S: usize>(
                 .map(|bytes| (platform, bytes))
         })
         .collect::<anyhow::Result<Vec<_>>>()?;
-    let family = options.family;
-    let energy = options.energy;
-    let eigenvector = linear_modes(system)?
-        .get(family.index())
-        .with_context(|| format!("a {N}-joint chain has no {family} family"))?
-        .eigenvector;
-    let (_, chart) =
-        mode_and_chart::<_, N, S>(system, family.index(), energy, options.chart_degree)
-            .with_context(|| format!("{family} eigenmode at {energy} J"))?;
-    let [controller, plant] = RobotExport {
-        names: &options.names,
-        model: system.params(),
-        e_ref: energy,
-        eigenvector: &std::array::from_fn(|j| eigenvector[j]),
-        chart: &chart.coefficients,
-        tau_max: options.tau_max,
-    }
-    .specs()
-    .map_err(anyhow::Error::msg)?;
-    // The controller's mode family, computed now so that no instance has
-    // to (0.5 to 2.5 s for 4 to 6 joints at fmi2ExitInitializationMode).
-    let family = family_resource::<N, S>(&controller)
-        .map_err(anyhow::Error::msg)
-        .context("the controller's mode family")?;
+    let Specs {
+        specs: [controller, plant],
+        family,
+    } = specs::<N, S>(system, options)?;
     let versions: &[FmiVersion] = if options.fmi3 {
         &[FmiVersion::Fmi2, FmiVersion::Fmi3]
     } else {
@@ -160,6 +140,58 @@ pub fn export<const N: usize, const S: usize>(
                 None => format!("{} (FMI 3.0 only)", p.name),
             })
             .collect(),
+    })
+}
+
+/// What an export's FMUs are, computed from the robot alone (no binary, no
+/// archive): the controller's and the plant's specs, from which their model
+/// descriptions are written, and the controller's precomputed mode family
+/// (`resources/eigenmpc-family.json`). Every number in them is computed
+/// with the same bits on every machine (`eigenmpc::math`, nalgebra without
+/// run-time kernels), so an export's descriptions and GUIDs do not depend
+/// on where it runs: `fmu-build --descriptions` writes them for the shipped
+/// pairs, and `tests/same_bits.sh` compares them across machines.
+pub struct Specs {
+    /// The controller's and the plant's specs.
+    pub specs: [ExportSpec; 2],
+    /// The controller's mode family as JSON (None: the controller computes
+    /// its own).
+    pub family: Option<String>,
+}
+
+/// The [`Specs`] of `system` exported with `options` (its `binary` and
+/// `fmi3` are not used).
+pub fn specs<const N: usize, const S: usize>(
+    system: &PlanarChain<N>,
+    options: &ExportOptions<'_>,
+) -> anyhow::Result<Specs> {
+    let family = options.family;
+    let energy = options.energy;
+    let eigenvector = linear_modes(system)?
+        .get(family.index())
+        .with_context(|| format!("a {N}-joint chain has no {family} family"))?
+        .eigenvector;
+    let (_, chart) =
+        mode_and_chart::<_, N, S>(system, family.index(), energy, options.chart_degree)
+            .with_context(|| format!("{family} eigenmode at {energy} J"))?;
+    let [controller, plant] = RobotExport {
+        names: &options.names,
+        model: system.params(),
+        e_ref: energy,
+        eigenvector: &std::array::from_fn(|j| eigenvector[j]),
+        chart: &chart.coefficients,
+        tau_max: options.tau_max,
+    }
+    .specs()
+    .map_err(anyhow::Error::msg)?;
+    // The controller's mode family, computed now so that no instance has
+    // to (0.5 to 2.5 s for 4 to 6 joints at fmi2ExitInitializationMode).
+    let family = family_resource::<N, S>(&controller)
+        .map_err(anyhow::Error::msg)
+        .context("the controller's mode family")?;
+    Ok(Specs {
+        specs: [controller, plant],
+        family,
     })
 }
 

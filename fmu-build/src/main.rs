@@ -14,14 +14,26 @@
 //! per platform, `resources/` with what the instance is and the
 //! controller's precomputed mode family, and `documentation/index.html`;
 //! each archive is loaded and stepped before the next, and the closed loop
-//! goes into an SSP archive. It also copies each model description into the
-//! checked-in `modelDescription/` (`fmi3/` for FMI 3.0), builds the C library
+//! goes into an SSP archive. It checks each model description against the
+//! checked-in copy in `modelDescription/` (`fmi3/` for FMI 3.0), builds the C library
 //! (`libeigenmpc_fmu.so`, the plain C API: [`C_LIBRARY`]) per platform into
 //! `target/fmu/c/<platform>/`, generates `include/eigenmpc.h` (the C API with
 //! cbindgen, config `cbindgen.toml`, and every shipped FMU's FMI 2.0
 //! value-reference and enumeration constants from its variable table) next
-//! to the standard FMI 2.0 headers, and rewrites the README's FMU variable
-//! tables from the variable tables.
+//! to the standard FMI 2.0 headers, and checks the book's FMU variable
+//! tables (`docs/book`) against the variable tables.
+//!
+//! A build writes nothing git tracks: where a checked-in description or
+//! table differs from the generated one (a developer changed a variable
+//! table, a default or a robot file), it fails and names the developer's
+//! command that rewrites them, `cargo run --release -p fmu-build --
+//! --update-checked-in`. Every number in them has the same bits on every
+//! machine (`eigenmpc::math`), so a user's build never finds a difference.
+//!
+//! `fmu-build --descriptions DIR` computes only the shipped pairs'
+//! descriptions and controller mode families (from `robots/` in the
+//! current folder, no build) into `DIR`: `tests/same_bits.sh` compares
+//! them across machines (native, baseline x86-64 and aarch64 under qemu).
 //!
 //! Adding a shipped FMU pair is a robot file and one row of [`SHIPPED`]; a
 //! platform is one row of `fmu_build::platform::PLATFORMS`.
@@ -279,28 +291,8 @@ fn c_library(ws: &Workspace, platform: &Platform) -> Result<PathBuf> {
 fn export_pair(ws: &Workspace, pair: &ShippedPair, binary: &Path) -> Result<Vec<(String, String)>> {
     let path = ws.root.join(pair.robot);
     let file = RobotFile::load(&path).with_context(|| format!("{}", path.display()))?;
-    if file.links() != pair.joints {
-        bail!(
-            "{}: {} links, the shipped pair {} has {}",
-            path.display(),
-            file.links(),
-            pair.ssp,
-            pair.joints
-        );
-    }
-    let tau_max = file
-        .torque_limits()
-        .map_or(1.0, |tl| tl.iter().copied().fold(f64::INFINITY, f64::min));
-    let options = ExportOptions {
-        names: pair.names(),
-        ssp: pair.ssp,
-        energy: pair.energy,
-        family: Family::InPhase,
-        tau_max,
-        chart_degree: 9,
-        binary,
-        fmi3: true,
-    };
+    check_joints(pair, &file, &path)?;
+    let options = export_options(pair, &file, binary);
     let out = ws.target.join("fmu");
     let n = pair.joints;
     let written = eigenmpc::with_joint_count!(
@@ -313,30 +305,93 @@ fn export_pair(ws: &Workspace, pair: &ShippedPair, binary: &Path) -> Result<Vec<
     }
     let mut descriptions = vec![];
     for spec in &written.specs {
-        let description = spec.description().map_err(anyhow::Error::msg)?;
-        descriptions.push((
-            format!("{}.xml", spec.model_name),
-            fmi2_slave::xml::model_description_xml(&description),
-        ));
-        descriptions.push((
-            format!("fmi3/{}.xml", spec.model_name),
-            fmi3_slave::xml::model_description_xml(&description),
-        ));
+        descriptions.extend(descriptions_of(spec)?);
     }
     Ok(descriptions)
 }
 
-/// Updates the checked-in model description `modelDescription/<file>`
-/// (`<id>.xml`, FMI 3.0: `fmi3/<id>.xml`); true if it changed.
-fn update_checked_in(ws: &Workspace, file: &str, xml: &str) -> Result<bool> {
-    let path = ws.root.join("modelDescription").join(file);
-    std::fs::create_dir_all(path.parent().context("modelDescription folder")?)?;
-    let old = std::fs::read_to_string(&path).unwrap_or_default();
-    if old == xml {
-        return Ok(false);
+/// The shipped pair's robot file has the pair's joint count.
+fn check_joints(pair: &ShippedPair, file: &RobotFile, path: &Path) -> Result<()> {
+    if file.links() != pair.joints {
+        bail!(
+            "{}: {} links, the shipped pair {} has {}",
+            path.display(),
+            file.links(),
+            pair.ssp,
+            pair.joints
+        );
     }
-    std::fs::write(&path, xml)?;
-    Ok(true)
+    Ok(())
+}
+
+/// How a shipped pair is exported: under its own names, at its energy, with
+/// the file's smallest torque limit.
+fn export_options<'a>(
+    pair: &'a ShippedPair,
+    file: &RobotFile,
+    binary: &'a Path,
+) -> ExportOptions<'a> {
+    let tau_max = file
+        .torque_limits()
+        .map_or(1.0, |tl| tl.iter().copied().fold(f64::INFINITY, f64::min));
+    ExportOptions {
+        names: pair.names(),
+        ssp: pair.ssp,
+        energy: pair.energy,
+        family: Family::InPhase,
+        tau_max,
+        chart_degree: 9,
+        binary,
+        fmi3: true,
+    }
+}
+
+/// A spec's checked-in model descriptions: `<id>.xml` (FMI 2.0) and
+/// `fmi3/<id>.xml` (FMI 3.0).
+fn descriptions_of(
+    spec: &eigenmpc_fmu_models::exported::ExportSpec,
+) -> Result<[(String, String); 2]> {
+    let description = spec.description().map_err(anyhow::Error::msg)?;
+    Ok([
+        (
+            format!("{}.xml", spec.model_name),
+            fmi2_slave::xml::model_description_xml(&description),
+        ),
+        (
+            format!("fmi3/{}.xml", spec.model_name),
+            fmi3_slave::xml::model_description_xml(&description),
+        ),
+    ])
+}
+
+/// What to do with the files git tracks that a build generates (the model
+/// descriptions in `modelDescription/`, the book's variable tables).
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum CheckedIn {
+    /// Compare them with the generated text (a user's build).
+    Check,
+    /// Rewrite them (the developer's `--update-checked-in`).
+    Update,
+}
+
+/// The developer's command that rewrites the checked-in files.
+const UPDATE_COMMAND: &str = "cargo run --release -p fmu-build -- --update-checked-in";
+
+impl CheckedIn {
+    /// Compares (or, updating, rewrites) the checked-in `path` (relative to
+    /// the workspace root) with `generated`; the path if it was out of date.
+    fn reconcile(self, ws: &Workspace, path: &str, generated: &str) -> Result<Option<String>> {
+        let full = ws.root.join(path);
+        let old = std::fs::read_to_string(&full).unwrap_or_default();
+        if old == generated {
+            return Ok(None);
+        }
+        if self == CheckedIn::Update {
+            std::fs::create_dir_all(full.parent().context("checked-in file's folder")?)?;
+            std::fs::write(&full, generated).with_context(|| format!("writing {path}"))?;
+        }
+        Ok(Some(path.to_string()))
+    }
 }
 
 /// `include/eigenmpc.h` with cbindgen, plus the standard FMI 2.0 headers it
@@ -394,19 +449,79 @@ fn header(ws: &Workspace) -> Result<PathBuf> {
     Ok(out)
 }
 
-/// Rewrites the README's FMU variable tables; true if they changed.
-fn update_readme(ws: &Workspace) -> Result<bool> {
-    let path = ws.root.join("README.md");
-    let old = std::fs::read_to_string(&path)?;
+/// The book's chapter with the FMU variable tables, as generated from the
+/// variable tables.
+fn tables(ws: &Workspace) -> Result<(String, String)> {
+    let path = eigenmpc_fmu_models::readme::TABLES_FILE;
+    let old = std::fs::read_to_string(ws.root.join(path)).with_context(|| path.to_string())?;
     let new = eigenmpc_fmu_models::readme::update(&old).map_err(|e| anyhow::anyhow!(e))?;
-    if new == old {
-        return Ok(false);
-    }
-    std::fs::write(&path, new)?;
-    Ok(true)
+    Ok((path.to_string(), new))
 }
 
+/// The model descriptions (FMI 2.0 `<id>.xml`, FMI 3.0 `fmi3/<id>.xml`)
+/// and the controllers' mode families (`<id>.family.json`) of the shipped
+/// pairs, from the robot files under `root`, without building anything.
+fn shipped_descriptions(root: &Path) -> Result<Vec<(String, String)>> {
+    let mut files = vec![];
+    for pair in SHIPPED {
+        let path = root.join(pair.robot);
+        let file = RobotFile::load(&path).with_context(|| format!("{}", path.display()))?;
+        check_joints(pair, &file, &path)?;
+        let options = export_options(pair, &file, Path::new(""));
+        let n = pair.joints;
+        let specs = eigenmpc::with_joint_count!(
+            n,
+            |N, S, NP| export::specs::<N, S>(&file.chain::<N>()?, &options)?,
+            otherwise bail!(eigenmpc::joints::unsupported(n))
+        );
+        for spec in &specs.specs {
+            files.extend(descriptions_of(spec)?);
+        }
+        if let Some(family) = specs.family {
+            files.push((
+                format!("{}.family.json", pair.controller.model_identifier),
+                family,
+            ));
+        }
+    }
+    Ok(files)
+}
+
+/// `fmu-build --descriptions DIR`: [`shipped_descriptions`] of the robot
+/// files in the current folder, written into `DIR`.
+fn write_descriptions(dir: &Path) -> Result<()> {
+    let root = std::env::current_dir()?;
+    for (file, text) in shipped_descriptions(&root)? {
+        let path = dir.join(&file);
+        std::fs::create_dir_all(path.parent().context("description folder")?)?;
+        std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))?;
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+const USAGE: &str = "usage: fmu-build [--update-checked-in | --descriptions DIR]
+  (none)               build the FMU binary and the C library for every platform
+                       (FMU_PLATFORMS narrows them), write the shipped FMUs, SSPs and
+                       include/eigenmpc.h into target/, and check the checked-in model
+                       descriptions and the book's variable tables: a difference fails
+  --update-checked-in  the same, rewriting the checked-in files that differ (a
+                       developer's command: commit what it rewrote)
+  --descriptions DIR   only the shipped pairs' model descriptions and mode families,
+                       from robots/ in the current folder, into DIR (no build)";
+
 fn main() -> Result<()> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let checked_in = match args.iter().map(String::as_str).collect::<Vec<_>>()[..] {
+        [] => CheckedIn::Check,
+        ["--update-checked-in"] => CheckedIn::Update,
+        ["--descriptions", dir] => return write_descriptions(Path::new(dir)),
+        ["--help" | "-h"] => {
+            println!("{USAGE}");
+            return Ok(());
+        }
+        _ => bail!("unexpected arguments {args:?}\n{USAGE}"),
+    };
     let ws = workspace()?;
     std::fs::create_dir_all(ws.target.join("fmu"))?;
     let platforms = platform::selected().map_err(anyhow::Error::msg)?;
@@ -419,11 +534,11 @@ fn main() -> Result<()> {
         );
     }
     let host = archive::robot_binary_path(&ws.target.join("fmu"));
+    let mut out_of_date = vec![];
     for pair in SHIPPED {
         for (file, xml) in export_pair(&ws, pair, &host)? {
-            if update_checked_in(&ws, &file, &xml)? {
-                println!("updated modelDescription/{file}: commit it");
-            }
+            let path = format!("modelDescription/{file}");
+            out_of_date.extend(checked_in.reconcile(&ws, &path, &xml)?);
         }
     }
     for p in &platforms {
@@ -432,8 +547,21 @@ fn main() -> Result<()> {
     }
     let h = header(&ws)?;
     println!("wrote {}", h.display());
-    if update_readme(&ws)? {
-        println!("updated the FMU variable tables of README.md: commit it");
+    let (path, text) = tables(&ws)?;
+    out_of_date.extend(checked_in.reconcile(&ws, &path, &text)?);
+    match (checked_in, out_of_date.is_empty()) {
+        (_, true) => Ok(()),
+        (CheckedIn::Update, false) => {
+            for path in &out_of_date {
+                println!("updated {path}: commit it");
+            }
+            Ok(())
+        }
+        (CheckedIn::Check, false) => bail!(
+            "the checked-in {} differ from what the variable tables, the defaults and \
+             robots/ generate (the FMUs in target/fmu are written): a developer's change \
+             that did not update them. Run `{UPDATE_COMMAND}` and commit them.",
+            out_of_date.join(", ")
+        ),
     }
-    Ok(())
 }

@@ -3,7 +3,7 @@
 //! The controller ([`controller`]) and plant ([`plant`]) FMUs generic in the
 //! number of joints `N`, each defined by one declarative variable table
 //! ([`fmi2_slave::table`]) from which the value references, the
-//! `modelDescription.xml`, the documentation page, the README tables, the C
+//! `modelDescription.xml`, the documentation page, the book's variable tables, the C
 //! header's constants and the start-value files follow.
 //!
 //! This crate exports no symbols: the one FMU binary (`robot-fmu`) invokes
@@ -20,7 +20,7 @@
 //!   binary, any joint count, controller or plant, told by its resources);
 //! - [`chain`]: the rigid-link parameters shared by controller and plant;
 //! - [`units`]: unit definitions;
-//! - [`readme`]: the README's FMU variable tables.
+//! - [`readme`]: the FMU variable tables of the book (`docs/book/`).
 
 pub mod chain;
 pub mod controller;

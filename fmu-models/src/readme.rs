@@ -1,9 +1,15 @@
-//! The README's FMU variable tables, generated from the variable tables:
+//! The FMU variable tables of the manual, generated from the variable tables:
+//! they live in the book's chapter on the FMUs' variables ([`TABLES_FILE`]),
 //! `cargo run -p fmu-build` rewrites them between their markers, and a test
-//! fails when README.md differs from the generated text.
+//! fails when that file differs from the generated text. (The module keeps
+//! its name from the time the tables were in README.md.)
 
 use crate::products::{controller_docs, plant_docs};
 use fmi2_slave::table::markdown;
+
+/// The file holding both tables between their markers, relative to the
+/// repository root: the book's chapter on the FMUs' variables.
+pub const TABLES_FILE: &str = "docs/book/src/fmu-variables.md";
 
 /// Marker line before the plant table.
 pub const PLANT_BEGIN: &str =
@@ -24,7 +30,8 @@ pub fn controller_table() -> Result<String, String> {
     markdown(&controller_docs())
 }
 
-/// `readme` with both tables replaced by the generated ones.
+/// `readme` (the text of [`TABLES_FILE`]) with both tables replaced by the
+/// generated ones; an error when a marker is missing.
 pub fn update(readme: &str) -> Result<String, String> {
     let text = replace(readme, PLANT_BEGIN, &plant_table()?)?;
     replace(&text, CONTROLLER_BEGIN, &controller_table()?)
@@ -33,11 +40,11 @@ pub fn update(readme: &str) -> Result<String, String> {
 fn replace(text: &str, begin: &str, table: &str) -> Result<String, String> {
     let start = text
         .find(begin)
-        .ok_or_else(|| format!("README: marker {begin} missing"))?
+        .ok_or_else(|| format!("{TABLES_FILE}: marker {begin} missing"))?
         + begin.len();
     let end = start
         + text[start..]
             .find(END)
-            .ok_or_else(|| format!("README: no {END} after {begin}"))?;
+            .ok_or_else(|| format!("{TABLES_FILE}: no {END} after {begin}"))?;
     Ok(format!("{}\n\n{table}\n{}", &text[..start], &text[end..]))
 }

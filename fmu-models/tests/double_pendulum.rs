@@ -8,6 +8,7 @@
 mod fmi2_exports {
     fmi2_slave::export_fmi2!(eigenmpc_fmu_models::products::DoublePendulumFmu);
 }
+use eigenmpc::math;
 use eigenmpc_fmu_models::products::DoublePendulumFmu;
 use fmi2_exports::*;
 use fmi2_slave::testing::TestInstance;
@@ -110,10 +111,10 @@ fn free_run_of_60_s_conserves_energy() {
     let e0 = fmu.outputs()[4];
     // E0 from the paper's formula: V = g (m1 + m2) l1 (1 - cos q1) + g m2 l2 (1 - cos(q1 + q2)), T = 1/2 qd'M qd
     let (q1, q2, w1, w2) = (1.2f64, -0.7f64, 0.5f64, 1.5f64);
-    let v = 9.81 * 2.0 * (1.0 - q1.cos()) + 9.81 * (1.0 - (q1 + q2).cos());
+    let v = 9.81 * 2.0 * (1.0 - math::cos(q1)) + 9.81 * (1.0 - math::cos(q1 + q2));
     let m = [
-        [3.0 + 2.0 * q2.cos(), 1.0 + q2.cos()],
-        [1.0 + q2.cos(), 1.0],
+        [3.0 + 2.0 * math::cos(q2), 1.0 + math::cos(q2)],
+        [1.0 + math::cos(q2), 1.0],
     ];
     let kin = 0.5 * (m[0][0] * w1 * w1 + 2.0 * m[0][1] * w1 * w2 + m[1][1] * w2 * w2);
     assert!((e0 - (v + kin)).abs() < 1e-12, "{e0} vs {}", v + kin);
@@ -157,8 +158,8 @@ fn energy_gain_equals_the_work_of_piecewise_constant_torques() {
     let mut work = 0.0;
     for k in 0..500 {
         let tau = [
-            3.0 * (0.37 * k as f64).sin(),
-            -2.0 * (0.23 * k as f64).cos(),
+            3.0 * math::sin(0.37 * k as f64),
+            -2.0 * math::cos(0.23 * k as f64),
         ];
         assert_eq!(fmu.set(&[vref("tau[1]"), vref("tau[2]")], &tau), OK);
         let before = fmu.outputs();
@@ -261,7 +262,7 @@ fn checked_in_model_description_matches_the_table() {
     let checked_in = std::fs::read_to_string(&path).unwrap_or_default();
     assert!(
         checked_in == generated,
-        "{} is out of date with the variable table: run `cargo run -p fmu-build` and commit it",
+        "{} is out of date with the variable table: run `cargo run --release -p fmu-build -- --update-checked-in` and commit it",
         path.display()
     );
 }
@@ -596,7 +597,7 @@ fn reset_then_the_same_run_equals_a_fresh_instance() {
         fmu.t = 0.0;
         (0..80)
             .map(|k| {
-                let tau = [0.3 * (k as f64 * 0.1).sin(), -0.2];
+                let tau = [0.3 * math::sin(k as f64 * 0.1), -0.2];
                 assert_eq!(fmu.set(&[vref("tau[1]"), vref("tau[2]")], &tau), OK);
                 fmu.step(0.025);
                 fmu.outputs()
@@ -620,7 +621,7 @@ impl Fmu {
         (0..n)
             .map(|k| {
                 let level = if k % 3 == 0 {
-                    0.1 * (k as f64).sin()
+                    0.1 * math::sin(k as f64)
                 } else {
                     0.0
                 };

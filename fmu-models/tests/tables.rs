@@ -1,5 +1,5 @@
 //! The variable tables: valid FMI 2.0 descriptions, the original 2-joint
-//! value references kept, the 3-joint layout, C constants and README tables.
+//! value references kept, the 3-joint layout, C constants and the book's tables.
 
 use eigenmpc_fmu_models::enums::CHART_SOURCE_PARAMETERS;
 use eigenmpc_fmu_models::products::*;
@@ -225,17 +225,20 @@ fn c_header_constants_follow_the_tables() {
     );
 }
 
-/// README.md's FMU variable tables are the generated ones (`cargo run -p
-/// fmu-build` rewrites them).
+/// The book's FMU variable tables (`readme::TABLES_FILE`) are the generated
+/// ones (`cargo run -p fmu-build` rewrites them).
 #[test]
 fn readme_tables_match_the_variable_tables() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../README.md");
+    let file = eigenmpc_fmu_models::readme::TABLES_FILE;
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("..")
+        .join(file);
     let readme = std::fs::read_to_string(&path).unwrap();
     let generated = eigenmpc_fmu_models::readme::update(&readme).unwrap();
     assert!(
         generated == readme,
-        "README.md's FMU variable tables are out of date with the variable tables: run \
-         `cargo run -p fmu-build` and commit README.md"
+        "the FMU variable tables of {file} are out of date with the variable tables: run \
+         `cargo run --release -p fmu-build -- --update-checked-in` and commit {file}"
     );
     // and the check can fail: a drifted row is noticed
     let drifted = readme.replacen("| `E_ref` |", "| `E_reference` |", 1);

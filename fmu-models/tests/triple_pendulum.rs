@@ -4,6 +4,7 @@
 //! the built shared library.
 
 use eigenmpc::integrate::{Tolerances, simulate_accurate};
+use eigenmpc::math;
 use eigenmpc::mechanics::{Joint, Link, PlanarChain, PlanarChainParams, Vector, state_energy};
 use fmi2_slave::testing::TestInstance;
 use fmi2_slave::{Model, ffi, xml};
@@ -118,7 +119,7 @@ fn free_run_conserves_energy_and_torques_do_their_work() {
     let mut work = 0.0;
     for k in 0..300 {
         let x = k as f64;
-        let tau = [(0.3 * x).sin(), -0.7 * (0.2 * x).cos(), 0.4];
+        let tau = [math::sin(0.3 * x), -0.7 * math::cos(0.2 * x), 0.4];
         fmu.set_tau(tau);
         let before = fmu.outputs();
         assert_eq!(fmu.step(0.01), OK);
@@ -244,7 +245,7 @@ fn checked_in_model_description_matches_the_table() {
     let checked_in = std::fs::read_to_string(&path).unwrap_or_default();
     assert!(
         checked_in == generated,
-        "{} is out of date with the variable table: run `cargo run -p fmu-build` and commit it",
+        "{} is out of date with the variable table: run `cargo run --release -p fmu-build -- --update-checked-in` and commit it",
         path.display()
     );
 }

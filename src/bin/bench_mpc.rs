@@ -241,8 +241,9 @@ struct RobotCase {
 }
 
 /// The robots of [`robots_table`]: the paper's pendulum and 3-link chain
-/// (point masses, no friction), the laboratory pendulums at the README's
-/// set-up, and a 3-link rigid chain with friction.
+/// (point masses, no friction), the laboratory pendulums at the set-up of
+/// the book's speed chapter (`docs/book/src/performance.md`), and a 3-link
+/// rigid chain with friction.
 const ROBOTS: &[RobotCase] = &[
     RobotCase {
         file: "robots/paper-double-pendulum.yml",

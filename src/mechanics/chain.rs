@@ -21,6 +21,7 @@
 //! in the shared parameter files; it tends to `cf pi/2` at speed).
 
 use super::{DynamicsJacobian, EnergyWithGradient, Matrix, MechanicalSystem, Vector, sin_cos};
+use crate::math;
 use nalgebra::SMatrix;
 use thiserror::Error;
 
@@ -487,7 +488,7 @@ impl<const N: usize> PlanarChain<N> {
     fn absolute_centrifugal(&self, phi: &Vector<N>, phid: &Vector<N>) -> Vector<N> {
         Vector::<N>::from_fn(|j, _| {
             (0..N)
-                .map(|l| self.coupling[(j, l)] * (phi[j] - phi[l]).sin() * phid[l] * phid[l])
+                .map(|l| self.coupling[(j, l)] * math::sin(phi[j] - phi[l]) * phid[l] * phid[l])
                 .sum()
         })
     }
@@ -507,7 +508,7 @@ impl<const N: usize> PlanarChain<N> {
     fn raw_potential(&self, q: &Vector<N>) -> f64 {
         let phi = Self::absolute(q);
         let gravity: f64 = (0..N)
-            .map(|j| self.gravity_amplitude[j] * (1.0 - phi[j].cos()))
+            .map(|j| self.gravity_amplitude[j] * (1.0 - math::cos(phi[j])))
             .sum();
         let springs: f64 = (0..N)
             .map(|j| {
@@ -534,14 +535,14 @@ impl<const N: usize> MechanicalSystem<N> for PlanarChain<N> {
 
     fn potential_gradient(&self, q: &Vector<N>) -> Vector<N> {
         let phi = Self::absolute(q);
-        let g_abs = Vector::<N>::from_fn(|j, _| self.gravity_amplitude[j] * phi[j].sin());
+        let g_abs = Vector::<N>::from_fn(|j, _| self.gravity_amplitude[j] * math::sin(phi[j]));
         Self::to_joint_forces(&g_abs) + self.spring_forces(q)
     }
 
     fn potential_hessian(&self, q: &Vector<N>) -> Matrix<N> {
         let phi = Self::absolute(q);
         let l = Self::l_matrix();
-        let diag = Vector::<N>::from_fn(|j, _| self.gravity_amplitude[j] * phi[j].cos());
+        let diag = Vector::<N>::from_fn(|j, _| self.gravity_amplitude[j] * math::cos(phi[j]));
         l.transpose() * Matrix::<N>::from_diagonal(&diag) * l
             + Matrix::<N>::from_diagonal(&self.stiffness())
     }
@@ -931,8 +932,8 @@ mod tests {
         let (sin, cos) = relative_sin_cos(&phi);
         for j in 0..3 {
             for l in 0..3 {
-                assert_eq!(sin[(j, l)], (phi[j] - phi[l]).sin());
-                assert_eq!(cos[(j, l)], (phi[j] - phi[l]).cos());
+                assert_eq!(sin[(j, l)], math::sin(phi[j] - phi[l]));
+                assert_eq!(cos[(j, l)], math::cos(phi[j] - phi[l]));
             }
         }
     }
@@ -942,11 +943,11 @@ mod tests {
         let phi = Vector::<3>::new(0.3, -1.7, 2.9);
         let (sin_phi, cos_phi, sin, cos) = trigonometry(&phi);
         for j in 0..3 {
-            assert!((sin_phi[j] - phi[j].sin()).abs() <= 2.3e-16);
-            assert!((cos_phi[j] - phi[j].cos()).abs() <= 2.3e-16);
+            assert!((sin_phi[j] - math::sin(phi[j])).abs() <= 2.3e-16);
+            assert!((cos_phi[j] - math::cos(phi[j])).abs() <= 2.3e-16);
             for l in 0..3 {
-                assert!((sin[(j, l)] - (phi[j] - phi[l]).sin()).abs() < 4.0 * f64::EPSILON);
-                assert!((cos[(j, l)] - (phi[j] - phi[l]).cos()).abs() < 4.0 * f64::EPSILON);
+                assert!((sin[(j, l)] - math::sin(phi[j] - phi[l])).abs() < 4.0 * f64::EPSILON);
+                assert!((cos[(j, l)] - math::cos(phi[j] - phi[l])).abs() < 4.0 * f64::EPSILON);
             }
         }
     }
@@ -1122,8 +1123,9 @@ mod tests {
         for &t2 in &[0.0, 0.4, -1.7, 3.0] {
             let q = Vector::<2>::new(0.3, t2);
             let m = p.mass_matrix(&q);
-            let m11 = m1 * l1 * l1 + m2 * (l1 + l2).powi(2) - 2.0 * m2 * l1 * l2 * (1.0 - t2.cos());
-            let m21 = m2 * (l2 * l2 + l1 * l2 * t2.cos());
+            let m11 =
+                m1 * l1 * l1 + m2 * (l1 + l2).powi(2) - 2.0 * m2 * l1 * l2 * (1.0 - math::cos(t2));
+            let m21 = m2 * (l2 * l2 + l1 * l2 * math::cos(t2));
             assert!((m[(0, 0)] - m11).abs() < 1e-12);
             assert!((m[(1, 0)] - m21).abs() < 1e-12);
             assert!((m[(0, 1)] - m21).abs() < 1e-12);
@@ -1134,7 +1136,9 @@ mod tests {
     #[test]
     fn potential_matches_paper_formula() {
         let p = pendulum();
-        let vstar = |q: &Vector<2>| -9.81 * q[0].cos() - 9.81 * (q[0].cos() + (q[0] + q[1]).cos());
+        let vstar = |q: &Vector<2>| {
+            -9.81 * math::cos(q[0]) - 9.81 * (math::cos(q[0]) + math::cos(q[0] + q[1]))
+        };
         let zero = Vector::<2>::zeros();
         for q in [Vector::<2>::new(0.3, -0.2), Vector::<2>::new(2.0, 1.0)] {
             assert!((p.potential(&q) - (vstar(&q) - vstar(&zero))).abs() < 1e-12);

@@ -4,6 +4,7 @@
 
 use super::{ControlOutput, ControlStatus, Controller};
 use crate::integrate::{Dopri5, IntegrationError, Tolerances};
+use crate::math;
 use crate::mechanics::{MechanicalSystem, Vector, state_derivative, state_energy};
 use nalgebra::SVector;
 
@@ -260,7 +261,7 @@ impl GaussianNoise {
     /// One standard normal sample.
     pub fn sample(&mut self) -> f64 {
         let (u, v) = (self.uniform(), self.uniform());
-        (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
+        (-2.0 * math::ln(u)).sqrt() * math::cos(2.0 * std::f64::consts::PI * v)
     }
 
     /// `z` with independent noise of standard deviation `angle` (rad) on

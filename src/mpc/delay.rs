@@ -33,6 +33,7 @@
 //! forward prediction starts from.
 
 use super::Controller;
+use crate::math;
 use crate::mechanics::{MechanicalSystem, Vector, state_derivative};
 use nalgebra::{SMatrix, SVector};
 use serde::{Deserialize, Serialize};
@@ -131,7 +132,7 @@ where
     pub(super) fn lag_decay(&self) -> f64 {
         let t = self.config.actuator_time_constant;
         if t > 0.0 {
-            (-self.config.dt / t).exp()
+            math::exp(-self.config.dt / t)
         } else {
             0.0
         }
@@ -204,7 +205,7 @@ where
             sum += u * length;
             if t > 0.0 {
                 // Integral of (a0 - u) exp(-s / T) over the piece.
-                let decay = (-offset / t).exp() - (-(offset + length) / t).exp();
+                let decay = math::exp(-offset / t) - math::exp(-(offset + length) / t);
                 sum += (a0 - u) * (t * decay);
             }
             p = end;
@@ -257,7 +258,7 @@ where
             if constant {
                 u
             } else {
-                u + (a0 - u) * (-s / t).exp()
+                u + (a0 - u) * math::exp(-s / t)
             }
         };
         // Steps no longer than the prediction's.

@@ -12,7 +12,7 @@
 //! rest ([`prediction_coulomb_sharpness`]): a step-aware smoothing. It
 //! underestimates the friction only at low speeds; [`FrictionSmoothing`]
 //! bounds the error and says up to which speed it exceeds 1 %. Measured on
-//! the laboratory robots A0 and B0 (README, issue 22), three substeps (`k`
+//! the laboratory robots A0 and B0 (`docs/book/src/robots.md`, issue 22), three substeps (`k`
 //! 37 and 22 where the law has 100) against the exact law with 9 and 14:
 //! band times within 3 %, tail energy within 1 % of E_ref of the exact
 //! law's (B0 at 2 J: -0.40 against +0.54 %; at 4 J: -0.70 against -0.49
@@ -25,6 +25,7 @@
 //! The exact law stays available: `prediction_model(chain, dt,
 //! prediction_substeps(chain, dt))` (up to [`MAX_PREDICTION_SUBSTEPS`]).
 
+use crate::math;
 use crate::mechanics::{Matrix, MechanicalSystem, PlanarChain, Vector};
 
 /// `h lambda` allowed for the stiffest friction mode in one RK4 step (just
@@ -61,7 +62,7 @@ impl FrictionSmoothing {
     /// The error of the slope `model_sharpness` against `sharpness`.
     pub fn new(sharpness: f64, model_sharpness: f64) -> Self {
         let (k, km) = (sharpness, model_sharpness.min(sharpness));
-        let error = |v: f64| ((k * v).atan() - (km * v).atan()) / std::f64::consts::FRAC_PI_2;
+        let error = |v: f64| (math::atan(k * v) - math::atan(km * v)) / std::f64::consts::FRAC_PI_2;
         if !(km > 0.0 && k.is_finite()) || km == k {
             return Self {
                 sharpness,
@@ -253,11 +254,12 @@ mod tests {
     fn the_smoothing_error_is_measured_where_it_says() {
         let (k, km) = (100.0, 25.0);
         let s = FrictionSmoothing::new(k, km);
-        let error = |v: f64| ((k * v).atan() - (km * v).atan()) / std::f64::consts::FRAC_PI_2;
+        let error = |v: f64| (math::atan(k * v) - math::atan(km * v)) / std::f64::consts::FRAC_PI_2;
         // The peak: atan 2 - atan 1/2 at 1/sqrt(k k') = 0.02 rad/s.
         assert!((s.largest_at - 0.02).abs() < 1e-15);
         assert!(
-            (s.largest - (2f64.atan() - 0.5f64.atan()) / std::f64::consts::FRAC_PI_2).abs() < 1e-15
+            (s.largest - (math::atan(2.0) - math::atan(0.5)) / std::f64::consts::FRAC_PI_2).abs()
+                < 1e-15
         );
         for v in [0.001, 0.01, 0.019, 0.021, 0.1, 1.0] {
             assert!(error(v) <= s.largest, "{v}");

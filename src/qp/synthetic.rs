@@ -6,6 +6,7 @@
 
 use super::OcpQp;
 use crate::integrate::rk4_step_sensitivity;
+use crate::math;
 use crate::mechanics::{DoublePendulum, Vector};
 use nalgebra::{DMatrix, DVector, SVector};
 
@@ -43,7 +44,7 @@ impl SplitMix64 {
     pub fn normal(&mut self) -> f64 {
         let u1 = self.unit().max(1e-300);
         let u2 = self.unit();
-        (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+        (-2.0 * math::ln(u1)).sqrt() * math::cos(std::f64::consts::TAU * u2)
     }
 
     /// Matrix with independent standard normal entries.
@@ -142,7 +143,7 @@ pub fn pendulum_rti_qp(rng: &mut SplitMix64, opts: &PendulumQpOptions) -> OcpQp 
         let rows = 1 + (rng.next_u64() % 6) as usize;
         let j = rng.normal_matrix(rows, cols);
         let w = DMatrix::from_diagonal(&DVector::from_fn(rows, |_, _| {
-            10f64.powf(rng.uniform(0.0, 2.0))
+            math::powf(10.0, rng.uniform(0.0, 2.0))
         }));
         let y = rng.normal_vector(rows);
         let mut h = j.transpose() * &w * &j;

@@ -1,7 +1,7 @@
 """`eigenmpc paper` (full run, release build): every claim's verdict and
 measured figure equal the committed `docs/paper/report.md`, so the docs are
 what the engine gives today. (The wall time is reported, not asserted: the
-one-minute goal is measured in the README.)"""
+one-minute goal is measured in the book, docs/book/src/paper.md.)"""
 
 import re
 import subprocess
@@ -45,7 +45,7 @@ def test_full_run_reproduces_the_committed_report(eigenmpc_cli, tmp_path):
         for g, w in zip(got, want):
             # Printed to 4 decimals; another libm may move the last digits.
             assert abs(g - w) <= 2e-3 + 0.02 * abs(w), f"{cid}: {fresh[cid][1]!r} vs {measured!r}"
-    # The verdicts the README quotes.
+    # The verdicts the book quotes (docs/book/src/paper.md).
     for cid in ("C1", "C4", "C6", "C7", "C14", "C18"):
         assert fresh[cid][0] == "holds", cid
     for cid in ("C5", "C12", "C17", "C19"):

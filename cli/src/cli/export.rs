@@ -14,11 +14,12 @@ use std::path::PathBuf;
 /// Arguments of `eigenmpc export`.
 #[derive(Args, Debug)]
 pub struct ExportArgs {
-    /// Robot parameter file (JSON or YAML, 1 to 6 joints; see README "Robots from a parameter
-    /// file").
+    /// Robot parameter file (JSON or YAML, 1 to 6 joints; see the book,
+    /// docs/book/src/robots.md).
     #[arg(long, value_name = "FILE")]
     model: PathBuf,
-    /// Folder for <NAME>EigenMPC.fmu, <NAME>Plant.fmu and <NAME>.ssp (created if missing).
+    /// Folder for `<NAME>EigenMPC.fmu`, `<NAME>Plant.fmu` and `<NAME>.ssp` (created if
+    /// missing).
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
     /// E_ref (J) and the energy of the chart the controller starts with; default 10 % of the
@@ -41,8 +42,8 @@ pub struct ExportArgs {
     /// executable's folder).
     #[arg(long, value_name = "FILE")]
     binary: Option<PathBuf>,
-    /// FMI versions: 2 (always written: <NAME>EigenMPC.fmu, ..., coupled by the SSP) and 3
-    /// (also fmi3/<NAME>EigenMPC.fmu and fmi3/<NAME>Plant.fmu, FMI 3.0 Co-Simulation).
+    /// FMI versions: 2 (always written: `<NAME>EigenMPC.fmu`, ..., coupled by the SSP) and 3
+    /// (also `fmi3/<NAME>EigenMPC.fmu` and `fmi3/<NAME>Plant.fmu`, FMI 3.0 Co-Simulation).
     #[arg(long, value_delimiter = ',', default_value = "2", value_parser = clap::value_parser!(u8).range(2..=3))]
     fmi: Vec<u8>,
 }

@@ -49,7 +49,7 @@ enum Command {
 #[derive(Args, Debug, Clone)]
 pub struct ModelArgs {
     /// Robot parameter file (JSON or YAML, flat keys m1 m2 l1 l2 r1 r2 I1 I2 Ir gr b1 b2 cf1
-    /// cf2 g ...; see README "Robots from a parameter file"). Replaces --m1 .. --g.
+    /// cf2 g ...; see the book, docs/book/src/robots.md). Replaces --m1 .. --g.
     #[arg(long, value_name = "FILE")]
     pub model: Option<PathBuf>,
     /// Mass at the tip of link 1 (kg).

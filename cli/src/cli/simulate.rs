@@ -108,7 +108,7 @@ pub struct SimulateArgs {
     #[arg(long, value_name = "T:E,...")]
     e_ref_at: Option<String>,
     /// Coulomb slope k of the controller's prediction model (s/rad; default: the plant's,
-    /// lowered so that an RK4 step resolves the friction, see README).
+    /// lowered so that an RK4 step resolves the friction, see docs/book/src/robots.md).
     #[arg(long, allow_negative_numbers = true)]
     model_coulomb_sharpness: Option<f64>,
     /// Penalise the whole torque tau instead of tau - tau_f(qd) (friction fought, not compensated).

@@ -16,7 +16,7 @@ use std::time::Instant;
 #[derive(Args, Debug)]
 pub struct SweepArgs {
     /// Spec file, TOML (`.toml`) or JSON: `duration`, `model`, `fixed`, `grid`, `random`,
-    /// `noise_seed`, `metric` (README "Parameter sweeps"). The options below add to it.
+    /// `noise_seed`, `metric` (the book, docs/book/src/sweeps.md). The options below add to it.
     #[arg(long, value_name = "FILE")]
     spec: Option<PathBuf>,
     /// A grid axis `NAME=V1,V2,...` or `NAME=FROM:TO:COUNT`; names are

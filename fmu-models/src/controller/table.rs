@@ -1,6 +1,6 @@
 //! The controller FMU's variable table for `N` joints: the single source of
 //! its variables, value references, start values, XML, documentation,
-//! README table, C constants and start-value files.
+//! table in the book, C constants and start-value files.
 //!
 //! Value references are laid out by [`fmi2_slave::table::Table::new`]: per
 //! base type consecutive in row order, the chart block at 100. For two

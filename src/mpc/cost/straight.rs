@@ -4,6 +4,7 @@
 //! `tanh(alpha E) + beta` (exploration at low energy).
 
 use super::{CostParams, CostVariant, Guide, Residuals, StagePoint};
+use crate::math;
 use crate::mechanics::{Matrix, MechanicalSystem};
 use nalgebra::SVector;
 
@@ -39,7 +40,7 @@ pub(super) fn blend<const N: usize, const NX: usize>(
     energy: f64,
     grad_e: &SVector<f64, NX>,
 ) {
-    let t = (params.alpha * energy).tanh();
+    let t = math::tanh(params.alpha * energy);
     let dt_dz = grad_e * (params.alpha * (1.0 - t * t));
     let g = 1.0 - t;
     r.position_z = r.position_z * g - r.position * dt_dz.transpose();

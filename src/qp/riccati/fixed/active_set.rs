@@ -442,6 +442,7 @@ fn llt_solve<const D: usize, const C: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math;
     use crate::qp::OcpQp;
     use crate::qp::riccati::RiccatiSettings;
     use nalgebra::{DMatrix, DVector};
@@ -451,7 +452,7 @@ mod tests {
     fn saturating_qp(horizon: usize) -> OcpQp {
         let mut qp = OcpQp::new(4, 2, horizon);
         for k in 0..horizon {
-            let wobble = |i: usize, j: usize| 0.02 * ((i + 2 * j + k) as f64).sin();
+            let wobble = |i: usize, j: usize| 0.02 * math::sin((i + 2 * j + k) as f64);
             qp.a[k] = DMatrix::from_fn(4, 4, |i, j| match (i, j) {
                 _ if i == j => 1.0,
                 _ if j == i + 2 => 0.1,
