@@ -11,6 +11,8 @@
 //! - [`joints`]: the joint counts compiled to fixed sizes (one table) and
 //!   [`with_joint_count!`], the dispatch from a count known at run time;
 //! - [`model_file`]: robots from JSON/YAML parameter files;
+//! - [`math`]: elementary functions with the same bits on every machine (the
+//!   shipped FMUs' defaults and GUIDs do not depend on where they are built);
 //! - [`integrate`]: RK4 with sensitivities and adaptive Dormand-Prince 5(4);
 //! - [`modes`]: linear modes, nonlinear eigenmodes (brake orbits) continued in
 //!   energy, the polynomial mode chart `X(s)` and its family over energy;
