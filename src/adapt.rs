@@ -57,6 +57,9 @@ pub struct AdaptOptions {
     /// Samples of each window the supervisor compares (before the change,
     /// and at the end of its watch).
     pub judge_samples: usize,
+    /// Time the energy must stay outside the 5 % band before the
+    /// estimate is tried without a steady loop, as after a stall (s).
+    pub stuck_time: f64,
     /// Top of a new model's mode family (J); `<= 0`: the default of
     /// [`FamilyOptions::for_system`] for the new model.
     pub family_energy_max: f64,
@@ -79,6 +82,7 @@ impl Default for AdaptOptions {
             max_validation_windows: 24,
             settle_samples: 160,
             judge_samples: 80,
+            stuck_time: 30.0,
             family_energy_max: -1.0,
             rls: RlsOptions::default(),
             synchronous: false,
@@ -94,6 +98,7 @@ impl AdaptOptions {
             ("min_change", self.min_change),
             ("trust_region", self.trust_region),
             ("max_scale_uncertainty", self.max_scale_uncertainty),
+            ("stuck_time", self.stuck_time),
         ] {
             if !(v.is_finite() && v > 0.0) {
                 return bad(format!("{name} = {v} must be finite and > 0"));
@@ -163,6 +168,10 @@ pub enum AdaptationStatus {
     Converged,
     /// The last model was taken back by the supervisor.
     Reverted,
+    /// The controller's stall supervisor released the torque
+    /// ([`Controller::supervisor_events`]): the last model was taken back,
+    /// or the estimate is being tried.
+    Supervisor,
 }
 
 /// Something a caller may want to log, with its figures.
@@ -255,6 +264,9 @@ struct Candidate<const N: usize, const NP: usize> {
     /// right).
     distinct: f64,
     windows: usize,
+    /// Proposed after a stall: taken as soon as its model is ready (the
+    /// loop it replaces is known to be bad; the watch judges it).
+    forced: bool,
 }
 
 /// A model swapped in and the one it replaced, under watch.
@@ -308,6 +320,10 @@ pub struct Adaptation<const N: usize, const NX: usize, const NP: usize> {
     samples: usize,
     /// No candidate before this sample (after a revert).
     hold_until: usize,
+    /// The controller's stall events already answered.
+    stalls_seen: usize,
+    /// Samples in a row with the energy outside the 5 % band.
+    off_target: usize,
     updates: usize,
     reverts: usize,
     refusals: [usize; 3],
@@ -356,6 +372,8 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
             generation: 0,
             samples: 0,
             hold_until: 0,
+            stalls_seen: 0,
+            off_target: 0,
             updates: 0,
             reverts: 0,
             refusals: [0; 3],
@@ -448,6 +466,11 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
     ) {
         let window = self.rls.add_sample(q, qd, felt, dt);
         self.samples += 1;
+        let stalls = controller.supervisor_events();
+        if stalls > self.stalls_seen {
+            self.stalls_seen = stalls;
+            self.stall(controller);
+        }
         self.observe(controller, q, qd, felt);
         if let Some(window) = window {
             self.score(&window);
@@ -472,7 +495,13 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
         }
         let features = energy_features::<N, NP>(&self.prior, q, qd);
         let energy = self.in_use.dot(&features);
-        let e2 = (energy - controller.config().cost.e_ref).powi(2);
+        let e_ref = controller.config().cost.e_ref;
+        let e2 = (energy - e_ref).powi(2);
+        if e2 > (0.05 * e_ref).powi(2) {
+            self.off_target += 1;
+        } else {
+            self.off_target = 0;
+        }
         let t2 = command.norm_squared();
         let judge = self.options.judge_samples;
         self.recent.add(t2, e2);
@@ -526,18 +555,56 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
         }
     }
 
-    fn look(&mut self, controller: &mut Controller<PlanarChain<N>, N, NX>) {
+    /// The controller called a stall: a model just taken goes back (the
+    /// loop was better before it); otherwise the estimate is tried at once,
+    /// without waiting for a steady loop (a stalled loop never is one).
+    fn stall(&mut self, controller: &mut Controller<PlanarChain<N>, N, NX>) {
+        // Its own events (Reverted, Accepted) say what it did.
         match std::mem::replace(&mut self.phase, Phase::Watching) {
-            Phase::Watching => self.propose(controller),
-            Phase::Validating(candidate) => self.decide(controller, candidate),
+            Phase::Supervising(mut watch) => {
+                watch.alarm = true;
+                self.judge(controller, watch);
+            }
+            Phase::Validating(mut candidate) => {
+                candidate.forced = true;
+                self.decide(controller, candidate);
+            }
+            Phase::Watching => {
+                self.propose(controller, true);
+                if let Phase::Validating(candidate) =
+                    std::mem::replace(&mut self.phase, Phase::Watching)
+                {
+                    self.decide(controller, candidate);
+                }
+            }
+        }
+        self.status = AdaptationStatus::Supervisor;
+    }
+
+    /// A loop that has stayed off its target for `stuck_time` (a wrong
+    /// model's limit cycle, say another mode's or a joint held bent) is
+    /// never steady: it is known bad, and the estimate is tried as after a
+    /// stall.
+    fn stuck(&self, dt: f64) -> bool {
+        self.off_target as f64 * dt >= self.options.stuck_time && self.samples >= self.hold_until
+    }
+
+    fn look(&mut self, controller: &mut Controller<PlanarChain<N>, N, NX>) {
+        let stuck = self.stuck(controller.config().dt);
+        match std::mem::replace(&mut self.phase, Phase::Watching) {
+            Phase::Watching => self.propose(controller, false),
+            Phase::Validating(mut candidate) => {
+                candidate.forced |= stuck;
+                self.decide(controller, candidate)
+            }
             Phase::Supervising(watch) => self.judge(controller, watch),
         }
     }
 
     /// Makes a candidate of the estimate when it has moved: shortened to
     /// the trust region, physical, not the model just reverted; posts its
-    /// model to the worker.
-    fn propose(&mut self, controller: &Controller<PlanarChain<N>, N, NX>) {
+    /// model to the worker. `forced` (after a stall): whatever the loop.
+    fn propose(&mut self, controller: &Controller<PlanarChain<N>, N, NX>, forced: bool) {
         // The change is measured on the estimate as a model would take it
         // (rotor inertias and friction not negative): a frictionless joint's
         // estimate scattering below zero is no change.
@@ -568,7 +635,8 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
         let saturating = 0.7 * (N as f64).sqrt() * config.tau_max;
         let steady = energy_error < 0.05 * config.cost.e_ref
             || (energy_error > 0.9 * energy_before && torque < saturating);
-        if self.recent_prev.samples == 0 || !steady || self.samples < self.hold_until {
+        let forced = forced || self.stuck(config.dt);
+        if !forced && (self.recent_prev.samples == 0 || !steady || self.samples < self.hold_until) {
             return;
         }
         // The estimate must have moved significantly from the model in use
@@ -585,7 +653,14 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
         if !significant {
             return;
         }
-        let step = (self.options.trust_region / change).min(1.0);
+        // After a stall the loop is known to be bad: the estimate is taken
+        // whole (the watch judges it; the model before comes back if the
+        // loop does worse).
+        let step = if forced {
+            1.0
+        } else {
+            (self.options.trust_region / change).min(1.0)
+        };
         let mut theta = BaseParameters::<N, NP> {
             theta: self.in_use + (estimate - self.in_use) * step,
         }
@@ -649,6 +724,7 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
             score: 0.0,
             distinct: 0.0,
             windows: 0,
+            forced,
         });
     }
 
@@ -665,9 +741,10 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
         let margin = (6.0 * candidate.distinct.sqrt()).max(0.25 * candidate.distinct);
         // The two must also differ by three standard deviations on those
         // windows: a candidate the windows cannot tell apart is not taken.
-        let better = candidate.windows >= o.min_validation_windows
-            && candidate.distinct >= 9.0
-            && candidate.score > margin;
+        let better = candidate.forced
+            || (candidate.windows >= o.min_validation_windows
+                && candidate.distinct >= 9.0
+                && candidate.score > margin);
         let worse = candidate.windows >= o.min_validation_windows && candidate.score < -margin;
         if !better && !worse && candidate.windows < o.max_validation_windows {
             self.phase = Phase::Validating(candidate);
@@ -865,6 +942,8 @@ pub struct AdaptationState<const N: usize, const NP: usize> {
     recent_prev: Block,
     samples: usize,
     hold_until: usize,
+    stalls_seen: usize,
+    off_target: usize,
     updates: usize,
     reverts: usize,
     refusals: [usize; 3],
@@ -899,6 +978,8 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
             recent_prev: self.recent_prev,
             samples: self.samples,
             hold_until: self.hold_until,
+            stalls_seen: self.stalls_seen,
+            off_target: self.off_target,
             updates: self.updates,
             reverts: self.reverts,
             refusals: self.refusals,
@@ -930,6 +1011,8 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
         self.recent_prev = state.recent_prev;
         self.samples = state.samples;
         self.hold_until = state.hold_until;
+        self.stalls_seen = state.stalls_seen;
+        self.off_target = state.off_target;
         self.updates = state.updates;
         self.reverts = state.reverts;
         self.refusals = state.refusals;

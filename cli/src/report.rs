@@ -87,6 +87,13 @@ pub fn summary_text<const N: usize>(s: &Summary<N>) -> String {
     if s.failures > 0 {
         let _ = writeln!(out, "samples with a failed solve:     {}", s.failures);
     }
+    if s.released > 0 {
+        let _ = writeln!(
+            out,
+            "stall supervisor:                {} stall(s), torque released for {} samples",
+            s.stalls, s.released
+        );
+    }
     out
 }
 

@@ -110,6 +110,10 @@ pub struct EigenMpcConfig {
     /// horizon * sample_period; 0 (default): immediate. As the FMU's
     /// `actuator_time_constant`.
     pub actuator_time_constant: f64,
+    /// The stall supervisor (1, default) or none (0): a joint held still by
+    /// a large torque, off the target energy, gets its torque released
+    /// (status `EIGENMPC_STATUS_RELEASED`). As the FMU's `supervisor`.
+    pub supervisor: i32,
 }
 
 /// Diagnostics of the last [`eigenmpc_step`].
@@ -133,8 +137,12 @@ pub struct EigenMpcStepInfo {
     /// Models the adaptation's supervisor took back (as `adapt_reverts`).
     pub adapt_reverts: u32,
     /// What the adaptation is doing: the FMU's `adaptation_status` item (1
-    /// idle, 2 excitation, 3 learning, 4 converged, 5 reverted).
+    /// idle, 2 excitation, 3 learning, 4 converged, 5 reverted, 6
+    /// supervisor).
     pub adaptation_status: i32,
+    /// Stalls the supervisor called so far (as the FMU's
+    /// `supervisor_events`).
+    pub supervisor_events: u32,
 }
 
 /// The controller behind a handle, whatever its number of joints.
@@ -182,6 +190,8 @@ impl<const N: usize, const NX: usize, const NP: usize> JointController
             adapt_refused: u32::try_from(self.refused_models()).unwrap_or(u32::MAX),
             adapt_reverts: u32::try_from(self.reverted_models()).unwrap_or(u32::MAX),
             adaptation_status: ADAPTATION_STATUS.item(self.adaptation_status()),
+            supervisor_events: u32::try_from(self.controller().supervisor_events())
+                .unwrap_or(u32::MAX),
         }
     }
 
@@ -223,7 +233,7 @@ impl EigenMpc {
 /// The config's fields as the controller FMU's parameters: `(C field,
 /// FMU name, value)`. The FMU's variable table checks them, so the C API
 /// and the FMU accept the same ranges.
-fn named_fields(config: &EigenMpcConfig) -> [(&'static str, &'static str, f64); 28] {
+fn named_fields(config: &EigenMpcConfig) -> [(&'static str, &'static str, f64); 29] {
     [
         ("variant", "variant", f64::from(config.variant)),
         ("e_ref", "E_ref", config.e_ref),
@@ -273,6 +283,7 @@ fn named_fields(config: &EigenMpcConfig) -> [(&'static str, &'static str, f64); 
             "actuator_time_constant",
             config.actuator_time_constant,
         ),
+        ("supervisor", "supervisor", f64::from(config.supervisor)),
     ]
 }
 
@@ -369,6 +380,7 @@ pub extern "C" fn eigenmpc_config_default(variant: i32) -> EigenMpcConfig {
         e_scale: s.tuning.e_scale,
         measurement_delay: s.measurement_delay,
         actuator_time_constant: s.actuator_time_constant,
+        supervisor: i32::from(s.supervisor),
     }
 }
 

@@ -14,5 +14,8 @@ pub const STATUS_QP_FAILED: i32 = 2;
 /// The state was NaN/Inf; the torque is the fallback.
 /// C API only: the FMU refuses NaN/Inf inputs with `fmi2Error` before a solve.
 pub const STATUS_INVALID_STATE: i32 = 3;
+/// The stall supervisor released the torque (zero): a joint had been held
+/// still by a large torque, off the target energy.
+pub const STATUS_RELEASED: i32 = 4;
 /// C API only: a null pointer or otherwise invalid argument; nothing was computed.
 pub const STATUS_BAD_ARGUMENT: i32 = -1;

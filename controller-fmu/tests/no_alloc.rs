@@ -177,6 +177,7 @@ fn c_api_step_does_not_allocate() {
             adapt_refused: 0,
             adapt_reverts: 0,
             adaptation_status: 0,
+            supervisor_events: 0,
         };
         for k in 0..SAMPLES {
             let ((status, last), n) = counted(|| {

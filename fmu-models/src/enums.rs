@@ -200,6 +200,13 @@ pub const ADAPTATION_STATUS: Enumeration<AdaptationStatus> = Enumeration {
             value: AdaptationStatus::Reverted,
             description: "The supervisor took the last model back (the loop did worse with it)",
         },
+        Item {
+            name: "supervisor",
+            item: 6,
+            value: AdaptationStatus::Supervisor,
+            description: "The stall supervisor released the torque: the last model taken went \
+                          back, or the estimate is being tried",
+        },
     ],
 };
 
@@ -254,6 +261,7 @@ mod tests {
             AdaptationStatus::Learning,
             AdaptationStatus::Converged,
             AdaptationStatus::Reverted,
+            AdaptationStatus::Supervisor,
         ] {
             assert_eq!(ADAPTATION_STATUS.value(ADAPTATION_STATUS.item(a)), Ok(a));
         }

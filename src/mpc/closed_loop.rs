@@ -289,8 +289,12 @@ pub struct Summary<const N: usize> {
     pub rms_distance: Option<f64>,
     /// Per-sample compute time: median, p95, p99, max (s).
     pub solve_time: [f64; 4],
-    /// Samples whose status was not OK.
+    /// Samples whose solve failed (a QP, or an invalid state).
     pub failures: usize,
+    /// Samples whose torque the stall supervisor released.
+    pub released: usize,
+    /// Releases (stalls the supervisor called).
+    pub stalls: usize,
     /// The window the RMS figures cover (s): the requested one, or the
     /// whole run when it is shorter.
     pub window: f64,
@@ -416,7 +420,22 @@ pub fn summarise<const N: usize, const NX: usize>(
             quantile(&times, 0.99),
             times.last().copied().unwrap_or(f64::NAN),
         ],
-        failures: trace.iter().filter(|s| !s.status.is_ok()).count(),
+        failures: trace
+            .iter()
+            .filter(|s| !s.status.is_ok() && s.status != ControlStatus::Released)
+            .count(),
+        released: trace
+            .iter()
+            .filter(|s| s.status == ControlStatus::Released)
+            .count(),
+        stalls: trace
+            .iter()
+            .enumerate()
+            .filter(|(i, s)| {
+                s.status == ControlStatus::Released
+                    && (*i == 0 || trace[i - 1].status != ControlStatus::Released)
+            })
+            .count(),
         window: window.min(t_end - trace.first().map_or(0.0, |s| s.time)),
     }
 }

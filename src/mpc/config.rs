@@ -4,6 +4,7 @@
 use super::Variant;
 use super::cost::{CostParams, PAPER_ENERGY_SCALE, Weights};
 use super::estimator::EstimatorConfig;
+use super::supervisor::SupervisorOptions;
 use crate::qp::QpBackend;
 use thiserror::Error;
 
@@ -112,6 +113,10 @@ pub struct MpcConfig {
     /// applied one `a` (s; 0, the default: immediate); same bounds as
     /// [`MpcConfig::measurement_delay`].
     pub actuator_time_constant: f64,
+    /// The stall supervisor (on by default): a torque held at its bound
+    /// without motion, off the target energy, is released
+    /// ([`SupervisorOptions`]).
+    pub supervisor: SupervisorOptions,
 }
 
 /// Longest measurement delay or actuator time constant the controller
@@ -151,6 +156,7 @@ impl MpcConfig {
             estimator: None,
             measurement_delay: 0.0,
             actuator_time_constant: 0.0,
+            supervisor: SupervisorOptions::default(),
         }
     }
 
@@ -210,6 +216,7 @@ impl MpcConfig {
         if let Some(e) = &self.estimator {
             e.validate()?;
         }
+        self.supervisor.validate()?;
         for (name, v) in [
             ("measurement_delay", self.measurement_delay),
             ("actuator_time_constant", self.actuator_time_constant),

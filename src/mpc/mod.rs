@@ -31,6 +31,7 @@ pub mod prediction;
 mod saved;
 mod sqp;
 mod status;
+mod supervisor;
 
 pub use config::{
     MAX_COMPENSATED_TIME, MAX_HORIZON, MAX_STARTUP_ITERATIONS, MpcConfig, MpcError, SqpOptions,
@@ -47,6 +48,7 @@ pub use prediction::{
 };
 pub use saved::ControllerState;
 pub use status::{ControlOutput, ControlStatus};
+pub use supervisor::SupervisorOptions;
 
 use crate::mechanics::{MechanicalSystem, Vector, state_energy};
 use crate::modes::ChartFamily;
@@ -104,6 +106,8 @@ pub struct Controller<S, const N: usize, const NX: usize> {
     /// The state the last feedback embedded as the plan's start (the
     /// measurement, filtered and predicted over delay and lag).
     embedded: Option<SVector<f64, NX>>,
+    /// The stall supervisor ([`supervisor`]).
+    supervisor: supervisor::Supervisor<N>,
 }
 
 /// QP failures in a row after which the plan is discarded and the next
@@ -173,6 +177,7 @@ where
                 config.dt,
             )),
             embedded: None,
+            supervisor: supervisor::Supervisor::new(),
         })
     }
 
@@ -495,7 +500,12 @@ where
             self.embedded = Some(*z);
         }
         let preparation_time = std::mem::take(&mut self.pending_preparation_time);
-        let mut out = if !measured {
+        // A release after a stall commands zero torque without solving (the
+        // plan was dropped; the estimator keeps following the measurements).
+        let releasing = measured && self.supervisor.release_sample();
+        let mut out = if releasing {
+            self.released()
+        } else if !measured {
             self.fallback(ControlStatus::InvalidState)
         } else if !self.initialised {
             self.initialise(z);
@@ -524,7 +534,10 @@ where
             ControlStatus::Solved | ControlStatus::NotConverged => {
                 self.consecutive_qp_failures = 0;
             }
-            ControlStatus::InvalidState => {}
+            ControlStatus::InvalidState | ControlStatus::Released => {}
+        }
+        if measured && !releasing {
+            self.supervise(z, &mut out);
         }
         let decay = self.lag_decay();
         self.history.push(&out.tau, decay);
@@ -578,6 +591,57 @@ where
             preparation_time: 0.0,
             feedback_time: 0.0,
         }
+    }
+
+    /// Zero torque: the supervisor's release after a stall.
+    fn released(&self) -> ControlOutput<N> {
+        ControlOutput {
+            tau: Vector::zeros(),
+            status: ControlStatus::Released,
+            qp_iterations: 0,
+            sqp_iterations: 0,
+            preparation_time: 0.0,
+            feedback_time: 0.0,
+        }
+    }
+
+    /// The stall supervisor's look at this sample (the state the plan
+    /// started from and the torque about to be sent); on a stall the plan
+    /// and the state estimate are dropped and the torque released.
+    fn supervise(&mut self, z: &SVector<f64, NX>, out: &mut ControlOutput<N>) {
+        let e_ref = self.config.cost.e_ref;
+        let energy_error = self.energy(z) - e_ref;
+        let verdict = self.supervisor.observe(
+            &self.config.supervisor,
+            self.config.dt,
+            z,
+            energy_error,
+            e_ref,
+            &out.tau,
+            self.config.tau_max,
+        );
+        if verdict == supervisor::Verdict::Stall {
+            self.reset();
+            *out = ControlOutput {
+                preparation_time: out.preparation_time,
+                feedback_time: out.feedback_time,
+                ..self.released()
+            };
+            // This sample is the release's first.
+            self.supervisor.release_sample();
+        }
+    }
+
+    /// Stalls the supervisor called so far (a torque held at its bound
+    /// without motion, off the target energy; each one released the
+    /// torque and dropped the plan and the state estimate).
+    pub fn supervisor_events(&self) -> usize {
+        self.supervisor.events()
+    }
+
+    /// Whether the supervisor is releasing the torque after a stall.
+    pub fn supervisor_releasing(&self) -> bool {
+        self.supervisor.releasing()
     }
 
     fn clip(&self, u: &Vector<N>) -> Vector<N> {

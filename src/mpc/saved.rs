@@ -5,6 +5,7 @@
 
 use super::delay::CommandHistory;
 use super::estimator::Ekf;
+use super::supervisor::Supervisor;
 use super::{Controller, CostParams, MpcError, Reference};
 use crate::mechanics::{MechanicalSystem, Vector};
 use crate::modes::ChartFamily;
@@ -33,6 +34,7 @@ pub struct ControllerState<S, const N: usize, const NX: usize> {
     /// The past commands (delay, lag and estimator need them).
     history: CommandHistory<N>,
     embedded: Option<SVector<f64, NX>>,
+    supervisor: Supervisor<N>,
     /// The QP solver's warm start ([`crate::qp::QpSolver::save_warm_start`]).
     solver: Vec<f64>,
 }
@@ -60,6 +62,7 @@ where
             estimator: self.estimator.clone(),
             history: self.history.clone(),
             embedded: self.embedded,
+            supervisor: self.supervisor.clone(),
             solver: self.solver.save_warm_start(),
         }
     }
@@ -128,6 +131,7 @@ where
         self.estimator = state.estimator;
         self.history = state.history;
         self.embedded = state.embedded;
+        self.supervisor = state.supervisor;
         // The QP is rebuilt from the plan (deterministic: the same numbers).
         self.prepared = false;
         self.pending_preparation_time = 0.0;

@@ -15,6 +15,10 @@ pub enum ControlStatus {
     QpFailed(QpStatus),
     /// The measured state was NaN/Inf; `tau` is the shifted previous plan's control, clipped.
     InvalidState,
+    /// The stall supervisor released the torque: `tau` is zero (a torque
+    /// had been held at its bound without motion, see
+    /// [`super::SupervisorOptions`]).
+    Released,
 }
 
 impl ControlStatus {
@@ -24,13 +28,14 @@ impl ControlStatus {
     }
 
     /// Integer code for C/FMI callers: 0 solved, 1 not converged, 2 QP
-    /// failed, 3 invalid state.
+    /// failed, 3 invalid state, 4 released by the stall supervisor.
     pub fn code(self) -> i32 {
         match self {
             ControlStatus::Solved => 0,
             ControlStatus::NotConverged => 1,
             ControlStatus::QpFailed(_) => 2,
             ControlStatus::InvalidState => 3,
+            ControlStatus::Released => 4,
         }
     }
 
@@ -43,6 +48,7 @@ impl ControlStatus {
             1 => Some(ControlStatus::NotConverged),
             2 => Some(ControlStatus::QpFailed(QpStatus::NumericalError)),
             3 => Some(ControlStatus::InvalidState),
+            4 => Some(ControlStatus::Released),
             _ => None,
         }
     }
@@ -60,6 +66,9 @@ impl std::fmt::Display for ControlStatus {
             }
             ControlStatus::InvalidState => {
                 f.write_str("measured state is NaN/Inf: holding the shifted previous plan")
+            }
+            ControlStatus::Released => {
+                f.write_str("stall: the supervisor released the torque (zero)")
             }
         }
     }

@@ -118,9 +118,19 @@ pub struct SimulateArgs {
     /// (rad) and speed (rad/s), Gaussian, deterministic (see --seed).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     noise: f64,
+    /// The speeds' measurement noise when it differs from the angles'
+    /// (rad/s; default: --noise), e.g. `--noise 0.005 --speed-noise 0.05`
+    /// as the laboratory robots' sensors.
+    #[arg(long, allow_negative_numbers = true)]
+    speed_noise: Option<f64>,
     /// Seed of the measurement noise.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// Switch the stall supervisor off (it releases the torque of a joint
+    /// held still by a large torque while the energy is off target; the
+    /// FMU's `supervisor`).
+    #[arg(long)]
+    no_supervisor: bool,
     /// Filter the measurement with the controller's extended Kalman filter:
     /// `ANGLE,SPEED,ACCELERATION` noise levels (rad, rad/s, rad/s^2), e.g.
     /// `0.05,0.05,0.3`.
@@ -371,6 +381,7 @@ fn run_simulate_for<const N: usize, const S: usize, const NP: usize>(
     config.cost.compensate_friction = !args.no_friction_compensation;
     config.measurement_delay = args.measurement_delay;
     config.actuator_time_constant = args.actuator_time_constant;
+    config.supervisor.enabled = !args.no_supervisor;
     if let Some(text) = &args.ekf {
         let levels = super::parse_list("ekf", text)?;
         let [angle_noise, speed_noise, acceleration_noise] = levels[..] else {
@@ -384,6 +395,12 @@ fn run_simulate_for<const N: usize, const S: usize, const NP: usize>(
     }
     if !(args.noise.is_finite() && args.noise >= 0.0) {
         bail!("--noise must be finite and >= 0");
+    }
+    if args
+        .speed_noise
+        .is_some_and(|v| !(v.is_finite() && v >= 0.0))
+    {
+        bail!("--speed-noise must be finite and >= 0");
     }
     if let Some(w) = args.w_e {
         config.cost.weights.energy = w;
@@ -492,8 +509,9 @@ fn run_simulate_for<const N: usize, const S: usize, const NP: usize>(
         |_, z| {
             history.push_back(*z);
             let seen = history.pop_front().unwrap_or(*z);
-            if args.noise > 0.0 {
-                noise.measure(&seen, args.noise, args.noise)
+            let speed_noise = args.speed_noise.unwrap_or(args.noise);
+            if args.noise > 0.0 || speed_noise > 0.0 {
+                noise.measure(&seen, args.noise, speed_noise)
             } else {
                 seen
             }

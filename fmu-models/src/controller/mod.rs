@@ -29,7 +29,7 @@ use crate::enums::ADAPTATION_STATUS;
 use crate::units;
 use adaptive::AdaptiveController;
 use eigenmpc::adapt::AdaptationEvent;
-use eigenmpc::mpc::{ControlOutput, FrictionSmoothing, MpcConfig, Variant};
+use eigenmpc::mpc::{ControlOutput, ControlStatus, FrictionSmoothing, MpcConfig, Variant};
 use fmi2_slave::table::{Element, Table};
 use fmi2_slave::{Context, DefaultExperiment, Model, ModelDescription, ModelError, Values};
 use nalgebra::SVector;
@@ -77,6 +77,7 @@ struct Io<const N: usize> {
     adapt_refused: u32,
     adapt_reverts: u32,
     adaptation_status: u32,
+    supervisor_events: u32,
 }
 
 impl<const N: usize> Io<N> {
@@ -114,6 +115,7 @@ impl<const N: usize> Io<N> {
             adapt_refused: scalar("adapt_refused")?,
             adapt_reverts: scalar("adapt_reverts")?,
             adaptation_status: scalar("adaptation_status")?,
+            supervisor_events: scalar("supervisor_events")?,
         })
     }
 }
@@ -130,6 +132,8 @@ pub struct ControllerFmu<P, const N: usize, const NX: usize, const NP: usize> {
     /// (each once; later ones are counted in `adapt_refused`).
     events_logged: usize,
     refusals_logged: [bool; 3],
+    /// Stalls of the supervisor already logged.
+    stalls_logged: usize,
     /// Solves that did not succeed (logged: the first and every
     /// [`FAILURE_LOG_EVERY`]-th).
     failed_solves: usize,
@@ -151,6 +155,7 @@ struct SavedController<const N: usize, const NX: usize, const NP: usize> {
     updates_reported: usize,
     events_logged: usize,
     refusals_logged: [bool; 3],
+    stalls_logged: usize,
     failed_solves: usize,
     clock: SampleClock,
     solved_state: SVector<f64, NX>,
@@ -252,6 +257,7 @@ impl<P: ControllerProduct<N> + Send, const N: usize, const NX: usize, const NP: 
             updates_reported: 0,
             events_logged: 0,
             refusals_logged: [false; 3],
+            stalls_logged: 0,
             failed_solves: 0,
             clock: SampleClock::new(ctx.experiment.start_time, settings.sample_period),
             settings,
@@ -303,6 +309,7 @@ impl<P: ControllerProduct<N> + Send, const N: usize, const NX: usize, const NP: 
             updates_reported: self.updates_reported,
             events_logged: self.events_logged,
             refusals_logged: self.refusals_logged,
+            stalls_logged: self.stalls_logged,
             failed_solves: self.failed_solves,
             clock: self.clock.clone(),
             solved_state: self.solved_state,
@@ -332,6 +339,7 @@ impl<P: ControllerProduct<N> + Send, const N: usize, const NX: usize, const NP: 
         self.updates_reported = saved.updates_reported;
         self.events_logged = saved.events_logged;
         self.refusals_logged = saved.refusals_logged;
+        self.stalls_logged = saved.stalls_logged;
         self.failed_solves = saved.failed_solves;
         self.clock = saved.clock;
         self.solved_state = saved.solved_state;
@@ -402,7 +410,8 @@ impl<P, const N: usize, const NX: usize, const NP: usize> ControllerFmu<P, N, NX
         let out = self.controller.step(&z, dt);
         self.solved_at = t;
         self.solved_state = z;
-        if !out.status.is_ok() {
+        // A release is the supervisor's doing, logged as a stall below.
+        if !out.status.is_ok() && out.status != ControlStatus::Released {
             self.failed_solves += 1;
             // A state no bounded torque recovers from can fail most
             // samples: log the first and then every FAILURE_LOG_EVERY-th
@@ -423,6 +432,7 @@ impl<P, const N: usize, const NX: usize, const NP: usize> ControllerFmu<P, N, NX
         }
         let energy = self.controller.controller().energy(&z);
         self.write_outputs(values, &out, energy);
+        self.log_stall(ctx, t, energy);
         self.log_adaptation(ctx, t);
         let updates = self.controller.model_updates();
         if updates != self.updates_reported {
@@ -465,6 +475,32 @@ impl<P, const N: usize, const NX: usize, const NP: usize> ControllerFmu<P, N, NX
             self.io.adaptation_status,
             ADAPTATION_STATUS.item(self.controller.adaptation_status()),
         );
+        values.set_integer(
+            self.io.supervisor_events,
+            count(self.controller.controller().supervisor_events()),
+        );
+    }
+
+    /// Logs a stall the supervisor called at this sample (OK level under
+    /// logEvents: the FMU did what it documents). Only then: a message
+    /// allocates.
+    fn log_stall(&mut self, ctx: &Context, t: f64, energy: f64) {
+        let stalls = self.controller.controller().supervisor_events();
+        if stalls == self.stalls_logged {
+            return;
+        }
+        self.stalls_logged = stalls;
+        let e_ref = self.controller.controller().config().cost.e_ref;
+        ctx.log.event(&format!(
+            "t = {t} s: stall {stalls}: a joint was held still by a large torque for 1 s with \
+             the energy at {energy:.4} J (E_ref {e_ref} J, not coming closer); the torque is \
+             released (zero, solver_status 4) and the plan and state estimate are dropped{}",
+            if self.settings.adapt {
+                "; the adaptation takes its last model back or tries its estimate"
+            } else {
+                ""
+            }
+        ));
     }
 
     /// Logs the adaptation's new event under logEvents (OK level: the FMU

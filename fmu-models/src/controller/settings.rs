@@ -160,6 +160,10 @@ pub struct Settings<const N: usize> {
     /// Time constant of the actuator's first-order lag (s; see
     /// [`MpcConfig::actuator_time_constant`]).
     pub actuator_time_constant: f64,
+    /// The stall supervisor ([`eigenmpc::mpc::SupervisorOptions`]): a
+    /// joint held still at a large torque, off the target energy, gets its
+    /// torque released.
+    pub supervisor: bool,
 }
 
 impl<const N: usize> HasChain<N> for Settings<N> {
@@ -208,6 +212,7 @@ impl<const N: usize> Settings<N> {
             adapt_realtime: false,
             measurement_delay: config.measurement_delay,
             actuator_time_constant: config.actuator_time_constant,
+            supervisor: config.supervisor.enabled,
         }
     }
 
@@ -235,6 +240,7 @@ impl<const N: usize> Settings<N> {
         };
         config.measurement_delay = self.measurement_delay;
         config.actuator_time_constant = self.actuator_time_constant;
+        config.supervisor.enabled = self.supervisor;
         config
     }
 

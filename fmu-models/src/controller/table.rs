@@ -100,14 +100,15 @@ pub fn table<const N: usize>() -> Table<Settings<N>> {
                  converged start-up of the Rust API, which the FMU does not use); 2 QP failed (torque = fallback: previous plan's next \
                  control, clipped; logged as a warning the first time and every 100th). 3 \
                  (invalid state) only occurs through the C API: the FMU refuses NaN/Inf \
-                 inputs with fmi2Error",
+                 inputs with fmi2Error. 4 released: the stall supervisor set the torque to \
+                 zero (see supervisor)",
             )
             .summary(
                 "0 solved (the first sample too: ten Gauss-Newton iterations from a \
                  zero-torque guess); 1 not converged (not reported by the FMU); 2 QP failed (fallback torque = previous plan's \
                  next control, clipped; warning logged the first time and every 100th); 3 \
                  invalid state occurs only through the C API: the FMU refuses NaN/Inf inputs \
-                 with fmi2Error",
+                 with fmi2Error; 4 released by the stall supervisor (torque zero)",
             ),
         Rw::<N>::enumeration(VARIANT.parameter, Shape::Scalar, VARIANT.fmi_type())
             .parameter(Field::integer(
@@ -254,6 +255,7 @@ pub fn table<const N: usize>() -> Table<Settings<N>> {
     );
     rows.extend(compensation_rows::<N>());
     rows.extend(adaptation_outcome_rows::<N>());
+    rows.extend(supervisor_rows::<N>());
     Table::new(N, rows)
 }
 
@@ -314,6 +316,34 @@ fn adaptation_outcome_rows<const N: usize>() -> Vec<Rw<N>> {
         )
         .output()
         .describe("What the online adaptation is doing (idle with adapt = false)"),
+    ]
+}
+
+/// The stall supervisor (after the older rows: their value references
+/// stay).
+fn supervisor_rows<const N: usize>() -> Vec<Rw<N>> {
+    vec![
+        Rw::<N>::boolean("supervisor", Shape::Scalar)
+            .parameter(Field::boolean(
+                |s, _| s.supervisor,
+                |s, _, v| s.supervisor = v,
+            ))
+            .describe(
+                "Stall supervisor: judged every 0.5 s over the last second. A stall: a still \
+                 joint (mean speed below 0.1 rad/s, angle within 0.04 rad) with its torque at its \
+                 bound, or the whole robot still with a torque of at least half of tau_max, while \
+                 the energy is outside the 5 % band and not coming closer (a wrong model's fixed \
+                 point, a stalled motor on hardware). The plan and the state estimate are dropped \
+                 and the torque released to zero for 0.5 s, doubled on each repeat within 20 s up \
+                 to 4 s (solver_status 4); with adapt = true the last model taken goes back, or \
+                 the estimate is tried at once (adaptation_status = supervisor). Each stall is \
+                 logged under logEvents and counted in supervisor_events",
+            ),
+        Rw::<N>::integer("supervisor_events", Shape::Scalar)
+            .output()
+            .describe(
+                "Stalls the supervisor called so far (each released the torque; logged under                  logEvents)",
+            ),
     ]
 }
 
