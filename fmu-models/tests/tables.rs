@@ -113,9 +113,12 @@ fn the_two_joint_controller_keeps_the_original_value_references() {
     assert_eq!(vr(&d, "adapt_refused"), (BaseType::Integer, 9));
     assert_eq!(vr(&d, "adapt_reverts"), (BaseType::Integer, 10));
     assert_eq!(vr(&d, "adaptation_status"), (BaseType::Integer, 11));
+    // then the stall supervisor (issue 37)
+    assert_eq!(vr(&d, "supervisor"), (BaseType::Boolean, 2));
+    assert_eq!(vr(&d, "supervisor_events"), (BaseType::Integer, 12));
     assert_eq!(
         d.variables.len(),
-        24 + 20 + 5 + 17 + 6 + 4 + 3 + 11 + 1 + 1 + 2 + 3
+        24 + 20 + 5 + 17 + 6 + 4 + 3 + 11 + 1 + 1 + 2 + 3 + 2
     );
 }
 

@@ -342,7 +342,8 @@ fn supervisor_rows<const N: usize>() -> Vec<Rw<N>> {
         Rw::<N>::integer("supervisor_events", Shape::Scalar)
             .output()
             .describe(
-                "Stalls the supervisor called so far (each released the torque; logged under                  logEvents)",
+                "Stalls the supervisor called so far (each released the torque; logged under \
+                 logEvents)",
             ),
     ]
 }
