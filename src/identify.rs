@@ -310,6 +310,10 @@ pub fn friction_features<const N: usize, const NP: usize>(
     f
 }
 
+/// Degrees of freedom the fit's residual has at least before it weighs the
+/// windows (its variance is then known within about +-50 %).
+pub const RESIDUAL_DOF: usize = 8;
+
 /// Settings of the energy-balance least squares.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct RlsOptions {
@@ -336,8 +340,9 @@ pub struct RlsOptions {
     /// Samples over which the measurement noise estimate averages.
     pub noise_memory: usize,
     /// Effective windows (forgotten) after which the window variance is
-    /// the residual of their fit (more than the number of base
-    /// parameters).
+    /// the residual of their fit; at least the number of base parameters
+    /// plus [`RESIDUAL_DOF`] (the fit's residual needs degrees of freedom:
+    /// a chain of 4-6 joints waits longer than the default).
     pub residual_windows: usize,
 }
 
@@ -347,12 +352,12 @@ impl Default for RlsOptions {
             forgetting: 0.999,
             prior_relative: 0.5,
             prior_floor: 0.05,
-            window: 20,
-            end_samples: 5,
+            window: 40,
+            end_samples: 40,
             equation_noise: 2e-4,
             min_information: 1e-4,
             noise_memory: 1200,
-            residual_windows: 36,
+            residual_windows: 24,
         }
     }
 }
@@ -547,12 +552,6 @@ impl<const N: usize, const NP: usize> EnergyBalanceRls<N, NP> {
     /// Starts at the prior chain's base parameters.
     pub fn new(prior: &PlanarChainParams<N>, options: RlsOptions) -> Result<Self, IdentifyError> {
         options.validate()?;
-        if options.residual_windows <= NP {
-            return Err(IdentifyError::NotPhysical(format!(
-                "residual_windows = {} must exceed the {NP} base parameters",
-                options.residual_windows
-            )));
-        }
         let theta = BaseParameters::<N, NP>::of(prior)?.theta;
         let variance = theta.map(|v| {
             (options.prior_relative * v.abs())
@@ -645,7 +644,7 @@ impl<const N: usize, const NP: usize> EnergyBalanceRls<N, NP> {
     /// sample rate (measured on the lab pendulum A0: 30-150 times the
     /// residual of the true parameters).
     pub fn window_variance(&self) -> f64 {
-        if self.count >= self.options.residual_windows as f64 {
+        if self.count >= self.residual_windows() {
             return self.variance;
         }
         self.sample_level_variance()
@@ -701,6 +700,13 @@ impl<const N: usize, const NP: usize> EnergyBalanceRls<N, NP> {
     /// next sample starts a new one. The estimate is kept.
     pub fn restart_window(&mut self) {
         self.last = None;
+    }
+
+    /// Effective windows after which the window variance is the fit's
+    /// residual ([`RlsOptions::residual_windows`], at least the base
+    /// parameters + [`RESIDUAL_DOF`]).
+    fn residual_windows(&self) -> f64 {
+        self.options.residual_windows.max(NP + RESIDUAL_DOF) as f64
     }
 
     /// Windows that updated the estimate so far.
@@ -805,7 +811,7 @@ impl<const N: usize, const NP: usize> EnergyBalanceRls<N, NP> {
         // its prediction (an external push, a knock: not the robot) gets
         // Huber's weight, once the variance is the windows' own; before,
         // the prediction's spread is the prior's and nothing is an outlier.
-        let weight = if self.count >= self.options.residual_windows as f64 {
+        let weight = if self.count >= self.residual_windows() {
             let spread = (variance + h.dot(&(self.covariance * h))).sqrt();
             let error = (y - h.dot(&self.estimate)).abs();
             if error > HUBER * spread {
@@ -824,7 +830,7 @@ impl<const N: usize, const NP: usize> EnergyBalanceRls<N, NP> {
         // point steps from the last variance (the prior's pull is small
         // against the windows', so they settle at once).
         let floor = self.options.equation_noise.powi(2);
-        let residual = self.count >= self.options.residual_windows as f64;
+        let residual = self.count >= self.residual_windows();
         let mut v = if residual {
             self.variance.max(floor)
         } else {

@@ -187,12 +187,13 @@ pub fn run_imperfect_disturbed<const N: usize, const NX: usize, const NP: usize>
             seen
         };
         let out = controller.step(&measured);
-        // The identification takes the state the controller used (its
-        // estimate, with a state estimator) and the torque it commanded
-        // over the sample before; a new model serves from the next sample.
+        // The identification takes the measured state (not a state
+        // estimate: the estimator's model is the one being corrected, and
+        // its estimate leans towards it) and the torque commanded over the
+        // sample before; a new model serves from the next sample.
         let started = Instant::now();
         if let Some(adaptation) = adaptation.as_deref_mut() {
-            let used = controller.state_estimate().copied().unwrap_or(measured);
+            let used = measured;
             let q = Vector::<N>::from_fn(|j, _| used[j]);
             let qd = Vector::<N>::from_fn(|j, _| used[N + j]);
             // The torque that acted before the measurement was taken, as

@@ -6,8 +6,8 @@
 #[path = "common/rough.rs"]
 mod rough_model;
 use eigenmpc::identify::{
-    BaseParameters, EnergyBalanceRls, IdentifyError, RlsOptions, WindowEquation, energy_features,
-    friction_features,
+    BaseParameters, EnergyBalanceRls, IdentifyError, RESIDUAL_DOF, RlsOptions, WindowEquation,
+    base_parameter_count, energy_features, friction_features,
 };
 use eigenmpc::integrate::{Dopri5, Tolerances};
 use eigenmpc::math;
@@ -371,4 +371,26 @@ fn a_negative_first_rotor_inertia_is_moved_into_the_link_inertia() {
         let (ea, eb) = (a.energy(&q, &qd), b.energy(&q, &qd));
         assert!((ea - eb).abs() < 1e-9 * eb.abs().max(1.0), "{ea} vs {eb}");
     }
+}
+
+/// Every joint count the project supports starts an identification with
+/// the default settings: the residual weighting waits for at least the
+/// base parameters + 8 windows (6 joints: 45 parameters, 53 windows).
+#[test]
+fn every_joint_count_identifies_with_the_default_settings() {
+    fn starts<const N: usize, const NP: usize>() {
+        assert_eq!(NP, base_parameter_count(N));
+        let rls = EnergyBalanceRls::<N, NP>::new(
+            &PlanarChainParams::<N>::default(),
+            RlsOptions::default(),
+        );
+        assert!(rls.is_ok(), "{N} joints: {:?}", rls.err());
+    }
+    starts::<1, 5>();
+    starts::<2, 11>();
+    starts::<3, 18>();
+    starts::<4, 26>();
+    starts::<5, 35>();
+    starts::<6, 45>();
+    assert!(RlsOptions::default().residual_windows >= base_parameter_count(2) + RESIDUAL_DOF);
 }

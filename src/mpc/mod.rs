@@ -467,6 +467,11 @@ where
     pub fn feedback(&mut self, z: &SVector<f64, NX>) -> ControlOutput<N> {
         let start = Instant::now();
         let measured = z.iter().all(|v| v.is_finite());
+        // The supervisor judges motion on the measurement itself: an
+        // estimator filtering with a wrong model sees the robot move where
+        // the model says the torque moves it, while it rests (a stall under
+        // the EKF went unnoticed that way).
+        let raw = *z;
         // A prediction not made in `prepare` (feedback called alone) is made here.
         self.predict_estimate();
         let estimate;
@@ -537,7 +542,7 @@ where
             ControlStatus::InvalidState | ControlStatus::Released => {}
         }
         if measured && !releasing {
-            self.supervise(z, &mut out);
+            self.supervise(&raw, &mut out);
         }
         let decay = self.lag_decay();
         self.history.push(&out.tau, decay);
@@ -605,8 +610,8 @@ where
         }
     }
 
-    /// The stall supervisor's look at this sample (the state the plan
-    /// started from and the torque about to be sent); on a stall the plan
+    /// The stall supervisor's look at this sample (the measured state,
+    /// not the estimate, and the torque about to be sent); on a stall the plan
     /// and the state estimate are dropped and the torque released.
     fn supervise(&mut self, z: &SVector<f64, NX>, out: &mut ControlOutput<N>) {
         let e_ref = self.config.cost.e_ref;

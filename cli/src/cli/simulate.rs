@@ -520,10 +520,11 @@ fn run_simulate_for<const N: usize, const S: usize, const NP: usize>(
             let Some(a) = adaptation.as_mut() else {
                 return;
             };
-            // As the FMU and the robustness runs feed it: the state the
-            // solve used (the EKF's estimate when it runs) and the torque
-            // that acted over the sample before the measurement.
-            let used = c.state_estimate().copied().unwrap_or(*measured);
+            // As the FMU and the robustness runs feed it: the measured
+            // state (not the EKF's estimate, which leans towards the model
+            // being corrected) and the torque that acted over the sample
+            // before the measurement.
+            let used = *measured;
             let q = Vector::<N>::from_fn(|j, _| used[j]);
             let qd = Vector::<N>::from_fn(|j, _| used[N + j]);
             let felt = c.torque_before_measurement();

@@ -60,16 +60,16 @@ impl<const N: usize, const NX: usize, const NP: usize> AdaptiveController<N, NX,
     }
 
     /// One sample at state `z`, `dt` seconds after the previous one:
-    /// solves, then feeds the identification with the state the solve used
-    /// (the state estimate with `state_estimator = ekf`, else `z`; at the
-    /// measurement's time) and the torque that acted over the sample
-    /// before the measurement, and takes a ready model
+    /// solves, then feeds the identification with the measured `z` (also
+    /// with `state_estimator = ekf`: the filter's estimate leans towards
+    /// the model the identification corrects) and the torque that acted
+    /// over the sample before the measurement, and takes a ready model
     /// for the next sample. Allocation-free; waits for the worker only
     /// without `adapt_realtime` (offline simulation).
     pub fn step(&mut self, z: &SVector<f64, NX>, dt: f64) -> ControlOutput<N> {
         let out = self.controller.step(z);
         if let Some(adaptation) = &mut self.adaptation {
-            let used = self.controller.state_estimate().copied().unwrap_or(*z);
+            let used = *z;
             let q = Vector::<N>::from_fn(|j, _| used[j]);
             let qd = Vector::<N>::from_fn(|j, _| used[N + j]);
             // The torque that acted before the measurement (the previous
