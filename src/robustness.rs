@@ -193,9 +193,8 @@ pub fn run_imperfect_disturbed<const N: usize, const NX: usize, const NP: usize>
         // sample before; a new model serves from the next sample.
         let started = Instant::now();
         if let Some(adaptation) = adaptation.as_deref_mut() {
-            let used = measured;
-            let q = Vector::<N>::from_fn(|j, _| used[j]);
-            let qd = Vector::<N>::from_fn(|j, _| used[N + j]);
+            let q = Vector::<N>::from_fn(|j, _| measured[j]);
+            let qd = Vector::<N>::from_fn(|j, _| measured[N + j]);
             // The torque that acted before the measurement was taken, as
             // far as the controller knows (the previous command when it
             // declares neither delay nor lag).

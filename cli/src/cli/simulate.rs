@@ -524,9 +524,8 @@ fn run_simulate_for<const N: usize, const S: usize, const NP: usize>(
             // state (not the EKF's estimate, which leans towards the model
             // being corrected) and the torque that acted over the sample
             // before the measurement.
-            let used = *measured;
-            let q = Vector::<N>::from_fn(|j, _| used[j]);
-            let qd = Vector::<N>::from_fn(|j, _| used[N + j]);
+            let q = Vector::<N>::from_fn(|j, _| measured[j]);
+            let qd = Vector::<N>::from_fn(|j, _| measured[N + j]);
             let felt = c.torque_before_measurement();
             a.sample(c, &q, &qd, &felt, dt);
             adapted.push(AdaptationSample {

@@ -69,9 +69,8 @@ impl<const N: usize, const NX: usize, const NP: usize> AdaptiveController<N, NX,
     pub fn step(&mut self, z: &SVector<f64, NX>, dt: f64) -> ControlOutput<N> {
         let out = self.controller.step(z);
         if let Some(adaptation) = &mut self.adaptation {
-            let used = *z;
-            let q = Vector::<N>::from_fn(|j, _| used[j]);
-            let qd = Vector::<N>::from_fn(|j, _| used[N + j]);
+            let q = Vector::<N>::from_fn(|j, _| z[j]);
+            let qd = Vector::<N>::from_fn(|j, _| z[N + j]);
             // The torque that acted before the measurement (the previous
             // command without a declared delay or lag).
             let felt = self.controller.torque_before_measurement();
