@@ -110,6 +110,11 @@ pub struct EigenMpcConfig {
     /// horizon * sample_period; 0 (default): immediate. As the FMU's
     /// `actuator_time_constant`.
     pub actuator_time_constant: f64,
+    /// The motor's response per sample, `u += a (tau - u)`, in (0, 2]; 1
+    /// (default): immediate. The step's torque is then the command that
+    /// makes the motor apply the plan's torque. Not together with
+    /// `actuator_time_constant`. As the FMU's `torque_response`.
+    pub torque_response: f64,
     /// The stall supervisor (1, default) or none (0): a joint held still by
     /// a large torque, off the target energy, gets its torque released
     /// (status `EIGENMPC_STATUS_RELEASED`). As the FMU's `supervisor`.
@@ -233,7 +238,7 @@ impl EigenMpc {
 /// The config's fields as the controller FMU's parameters: `(C field,
 /// FMU name, value)`. The FMU's variable table checks them, so the C API
 /// and the FMU accept the same ranges.
-fn named_fields(config: &EigenMpcConfig) -> [(&'static str, &'static str, f64); 29] {
+fn named_fields(config: &EigenMpcConfig) -> [(&'static str, &'static str, f64); 30] {
     [
         ("variant", "variant", f64::from(config.variant)),
         ("e_ref", "E_ref", config.e_ref),
@@ -284,6 +289,7 @@ fn named_fields(config: &EigenMpcConfig) -> [(&'static str, &'static str, f64); 
             config.actuator_time_constant,
         ),
         ("supervisor", "supervisor", f64::from(config.supervisor)),
+        ("torque_response", "torque_response", config.torque_response),
     ]
 }
 
@@ -381,6 +387,7 @@ pub extern "C" fn eigenmpc_config_default(variant: i32) -> EigenMpcConfig {
         measurement_delay: s.measurement_delay,
         actuator_time_constant: s.actuator_time_constant,
         supervisor: i32::from(s.supervisor),
+        torque_response: s.torque_response,
     }
 }
 

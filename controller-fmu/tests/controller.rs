@@ -1306,3 +1306,47 @@ fn c_api_takes_delay_and_lag() {
         assert!(text.contains(field), "{text}");
     }
 }
+
+/// The C API takes the motor's response per sample (default 1, immediate):
+/// a declared overshooting motor gets a command that differs from an
+/// immediate motor's, and a response outside (0, 2] or one declared with a
+/// first-order lag is refused, naming the field.
+#[test]
+fn c_api_takes_the_torque_response() {
+    let mut err = [0 as std::ffi::c_char; 300];
+    let cfg = eigenmpc_config_default(VARIANT_CURVED);
+    assert_eq!(cfg.torque_response, 1.0);
+    let first_command = |cfg: &EigenMpcConfig| {
+        let mpc = unsafe { eigenmpc_create(cfg, ptr::null(), err.as_ptr().cast_mut(), 300) };
+        assert!(!mpc.is_null());
+        let z = [0.05, 0.05, 0.0, 0.0];
+        let mut tau = [[f64::NAN; 2]; 2];
+        unsafe {
+            for t in &mut tau {
+                assert!(eigenmpc_step(mpc, z.as_ptr(), t.as_mut_ptr()) >= 0);
+            }
+            eigenmpc_free(mpc);
+        }
+        tau
+    };
+    let immediate = first_command(&cfg);
+    let overshooting = first_command(&EigenMpcConfig {
+        torque_response: 2.0,
+        ..cfg
+    });
+    // From rest the first command makes a = 2 apply it doubled: half of it.
+    for j in 0..2 {
+        assert!((overshooting[0][j] - 0.5 * immediate[0][j]).abs() < 1e-12);
+    }
+    for (response, lag) in [(0.0, 0.0), (2.5, 0.0), (f64::NAN, 0.0), (0.5, 0.05)] {
+        let bad_cfg = EigenMpcConfig {
+            torque_response: response,
+            actuator_time_constant: lag,
+            ..cfg
+        };
+        let bad = unsafe { eigenmpc_create(&bad_cfg, ptr::null(), err.as_mut_ptr(), err.len()) };
+        assert!(bad.is_null(), "{response}, {lag}");
+        let text = unsafe { CStr::from_ptr(err.as_ptr()) }.to_str().unwrap();
+        assert!(text.contains("torque_response"), "{text}");
+    }
+}

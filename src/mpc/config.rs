@@ -113,6 +113,16 @@ pub struct MpcConfig {
     /// applied one `a` (s; 0, the default: immediate); same bounds as
     /// [`MpcConfig::measurement_delay`].
     pub actuator_time_constant: f64,
+    /// The motor's response per sample, `u += a (tau - u)`: the torque
+    /// applied over a sample moves from the last one's by `a` times its
+    /// distance to the command (1, the default: immediate; `a < 1` lags,
+    /// `1 < a <= 2` overshoots, 2 oscillates without decay). The plan's
+    /// controls are the applied torques, bounded per stage by what the
+    /// motor can reach from the last one; the command is the one that
+    /// makes the motor apply the plan's first ([`MpcConfig::torque_response`]
+    /// and [`MpcConfig::actuator_time_constant`] are alternatives: one of
+    /// them at most).
+    pub torque_response: f64,
     /// The stall supervisor (on by default): a torque held at its bound
     /// without motion, off the target energy, is released
     /// ([`SupervisorOptions`]).
@@ -156,6 +166,7 @@ impl MpcConfig {
             estimator: None,
             measurement_delay: 0.0,
             actuator_time_constant: 0.0,
+            torque_response: 1.0,
             supervisor: SupervisorOptions::default(),
         }
     }
@@ -231,6 +242,17 @@ impl MpcConfig {
             if v > self.horizon as f64 * self.dt {
                 return bad(name, v, "must be at most the horizon's length (horizon dt)");
             }
+        }
+        // Beyond 2 the motor's own response diverges (|1 - a| > 1).
+        if !(self.torque_response > 0.0 && self.torque_response <= 2.0) {
+            return bad("torque_response", self.torque_response, "must be in (0, 2]");
+        }
+        if self.torque_response != 1.0 && self.actuator_time_constant > 0.0 {
+            return bad(
+                "torque_response",
+                self.torque_response,
+                "describes the motor's lag per sample: declare it or actuator_time_constant, not both",
+            );
         }
         if let Startup::Iterations(n) = self.startup
             && !(1..=MAX_STARTUP_ITERATIONS).contains(&n)

@@ -138,6 +138,12 @@ where
         let dt = self.config.dt;
         let q_eq = self.system.equilibrium();
         let mut substeps_taken = 0;
+        let applied = self.history.entry(1).0;
+        let mut bounds = super::response::StageBounds::<N>::new(
+            self.config.torque_response,
+            self.config.tau_max,
+            &applied,
+        );
         for k in 0..nh {
             // The Jacobian at the interval's start is the first RK4 stage's
             // and its acceleration chooses the substeps: computed once.
@@ -150,7 +156,9 @@ where
             let (x_next, a, b) = self.interval_sensitivity_from(z, u, substeps, &first);
             let m =
                 stage_model_at::<S, N, NX>(&self.system, &self.reference, &cost, z, u, dt, &energy);
-            let tau_max = Vector::<N>::repeat(self.config.tau_max);
+            // Stage k may apply what the motor reaches from the torque it
+            // applies now ([`super::response`]; |tau| <= tau_max without a response).
+            let (lower, upper) = bounds.next().expect("one per stage");
             let st = &mut self.stages.stages[k];
             st.a = a;
             st.b = b;
@@ -160,8 +168,8 @@ where
             st.r = m.r;
             st.q_lin = m.gz;
             st.r_lin = m.gu;
-            st.u_lower = -tau_max - self.us[k];
-            st.u_upper = tau_max - self.us[k];
+            st.u_lower = lower - self.us[k];
+            st.u_upper = upper - self.us[k];
         }
         self.substeps_taken = substeps_taken;
         let scale = dt * self.config.terminal_scale;

@@ -28,6 +28,7 @@ mod estimator;
 mod linearise;
 pub use linearise::SPEED_REACH;
 pub mod prediction;
+mod response;
 mod saved;
 mod sqp;
 mod status;
@@ -544,8 +545,18 @@ where
         if measured && !releasing {
             self.supervise(&raw, &mut out);
         }
+        // The plan's first control is the torque to apply; with a declared
+        // motor response the command is the one that makes the motor apply
+        // it, and the history keeps what the motor applies ([`response`]).
+        let (command, applied) = response::command(
+            self.config.torque_response,
+            self.config.tau_max,
+            &self.history.entry(1).0,
+            &out.tau,
+        );
+        out.tau = command;
         let decay = self.lag_decay();
-        self.history.push(&out.tau, decay);
+        self.history.push(&applied, decay);
         out.preparation_time = preparation_time;
         out.feedback_time = start.elapsed().as_secs_f64();
         out
@@ -635,6 +646,15 @@ where
             // This sample is the release's first.
             self.supervisor.release_sample();
         }
+    }
+
+    /// The torque the motor applies over the sample since the last
+    /// feedback, as the controller expects it: the last command, or with a
+    /// declared [`MpcConfig::torque_response`] the motor's response to it
+    /// (with an [`MpcConfig::actuator_time_constant`] the command, which
+    /// the lag follows).
+    pub fn applied_torque(&self) -> Vector<N> {
+        self.history.entry(1).0
     }
 
     /// Stalls the supervisor called so far (a torque held at its bound

@@ -44,13 +44,17 @@ pub struct RobustnessArgs {
     /// 0.005 rad, rad/s).
     #[arg(long)]
     ekf: bool,
+    /// Do not tell the controller the case's motor response and measurement delay (by default
+    /// it is told them, as its filter is told the noise): robustness to them unmodelled.
+    #[arg(long)]
+    undeclared: bool,
     /// Worker threads (default: all local cores); the numbers do not depend on it.
     #[arg(long)]
     threads: Option<usize>,
 }
 
 /// How the cases are made and scored, for the report's reader.
-fn definitions(sweep: Sweep) -> String {
+fn definitions(sweep: Sweep, declared: bool) -> String {
     use eigenmpc_cli::robustness::*;
     format!(
         "One thing differs from the controller's set-up per run, {steps} values per range (ends included). \
@@ -68,17 +72,30 @@ fn definitions(sweep: Sweep) -> String {
          (a > 1 overshoots). \
          **Measurement delay** 0 .. {d} ms: the controller sees the state of exactly that long ago \
          (a delay that is not a whole number of samples is integrated to the instant, not rounded). \
+         {declared} \
          **Torque pulses**: {pulses} random profiles (seeded by their number, the same on every machine), \
          {ppj} rectangular pulses per joint, start uniform in [5 s, duration - 15 s], length uniform \
          {l0} .. {l1} s, torque uniform in +-{mp} % of tau_max, held over the samples that start within \
          the pulse and added to the motor's torque. \
          **Score**: the share of runs whose mean plant energy over the last 5 s is within {e} % of E_ref \
          and whose RMS motor torque over the last 5 s is, per joint, at most the plant's RMS friction \
-         torque along that stretch + {ta} N m.",
+         torque along that stretch + {ta} N m ({tn_a} N m where the set-up adds noise: measurement \
+         noise, torque noise, rough model + noise). \
+         **Rough model + noise**: {steps} seeded random models of the robot as the controller's model \
+         (each link's mass, centre-of-mass distance and inertia about the centre of mass off by up to \
+         {rough} %, uniformly, no friction), the plant the robot itself, sensors with {rn} rad / {rs} \
+         rad/s of noise and the EKF told it.",
         steps = sweep.steps,
         share = 100.0 * ZERO_NOMINAL_SHARE,
         an = MAX_MEASUREMENT_NOISE.0,
         tn = 100.0 * MAX_TORQUE_NOISE,
+        declared = if declared {
+            "The controller is told the case's torque response and measurement delay \
+             (`torque_response`, `measurement_delay`), as its filter is told the noise."
+        } else {
+            "The controller is not told the torque response or the measurement delay \
+             (`--undeclared`): it assumes an immediate motor and a current measurement."
+        },
         a0 = RESPONSE_RANGE.0,
         a1 = RESPONSE_RANGE.1,
         d = 1000.0 * MAX_DELAY,
@@ -89,6 +106,10 @@ fn definitions(sweep: Sweep) -> String {
         mp = 100.0 * MAX_PULSE,
         e = 100.0 * ENERGY_TOLERANCE,
         ta = TORQUE_ALLOWANCE,
+        tn_a = NOISY_TORQUE_ALLOWANCE,
+        rough = 100.0 * ROUGH_MODEL_ERROR,
+        rn = ROUGH_NOISE.0,
+        rs = ROUGH_NOISE.1,
     )
 }
 
@@ -122,6 +143,7 @@ fn run_for<const N: usize, const S: usize, const NP: usize>(
     let mut setup = Setup::new(&nominal, args.energy, args.tau_max, args.duration)
         .map_err(anyhow::Error::msg)?;
     setup.ekf = args.ekf;
+    setup.declared = !args.undeclared;
     // Refuse a configuration the controller cannot build before the sweep.
     setup.settings.build::<S>().map_err(anyhow::Error::msg)?;
     let sweep = Sweep {
@@ -196,7 +218,7 @@ fn run_for<const N: usize, const S: usize, const NP: usize>(
         } else {
             "; state estimator: EKF where the sensors are noisy"
         },
-        definitions(sweep),
+        definitions(sweep, setup.declared),
     );
     let md = args.out.join("robustness.md");
     std::fs::write(&md, markdown(&title, &rows))

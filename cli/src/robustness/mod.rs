@@ -4,15 +4,19 @@
 //! nominal model) against plants and set-ups that differ from it in one
 //! thing at a time: each model parameter +-25 % (21 factors 0.75 .. 1.25),
 //! measurement noise up to 0.01 rad and 0.1 rad/s, torque noise up to 20 %
-//! of the torque bound, torque response `a` 0.25 .. 2, measurement delay
-//! 0 .. 40 ms, and 50 random torque-pulse profiles of up to 50 % of the
-//! torque bound. Each run with and without online adaptation.
+//! of the torque bound, torque response `a` 0.1 .. 2, measurement delay
+//! 0 .. 40 ms (both told to the controller unless [`Setup::declared`] is
+//! off), 50 random torque-pulse profiles of up to 50 % of the torque
+//! bound, and 21 rough models of the robot as the controller's model with
+//! the laboratory's sensor noise. Each run with and without online
+//! adaptation.
 //!
 //! A run succeeds ([`succeeds`]) when the mean plant energy over the last
 //! 5 s is within 1 % of `E_ref` and the RMS motor torque over the last 5 s
 //! is, per joint, at most the plant's friction torque along the orbit plus
-//! 0.03 N m: the energy is held, and held without fighting the plant. The
-//! score of a category is the share of its runs that succeed.
+//! 0.03 N m (0.1 N m where the set-up adds noise): the energy is held, and
+//! held without fighting the plant. The score of a category is the share
+//! of its runs that succeed.
 //!
 //! Any robot of the joint-count table: the per-link categories have one
 //! parameter per link, the pulses act on every joint.
@@ -83,6 +87,10 @@ pub enum Perturbation {
     Delay(f64),
     /// Random torque-pulse profile number `k` ([`pulse_profile`]).
     TorquePulses(u64),
+    /// The plant is the nominal robot and the *controller's* model is
+    /// rough model number `k` ([`rough_model`]), with the sensors' noise
+    /// [`ROUGH_NOISE`]: the set-up of a real robot.
+    RoughModelNoisy(u64),
 }
 
 /// One run of the sweep.
@@ -101,7 +109,7 @@ pub struct Case {
 }
 
 /// The categories in report order.
-pub const CATEGORIES: [&str; 11] = [
+pub const CATEGORIES: [&str; 12] = [
     "mass",
     "centre of mass",
     "inertia",
@@ -113,6 +121,7 @@ pub const CATEGORIES: [&str; 11] = [
     "torque response",
     "measurement delay",
     "torque pulses",
+    "rough model + noise",
 ];
 
 /// A run succeeds within this share of `E_ref` (mean energy, last 5 s).
@@ -120,6 +129,54 @@ pub const ENERGY_TOLERANCE: f64 = 0.01;
 
 /// A run succeeds with RMS torque up to the friction torque plus this (N m).
 pub const TORQUE_ALLOWANCE: f64 = 0.03;
+
+/// The allowance where the set-up adds noise (measurement noise, torque
+/// noise, rough model + noise): noise costs torque that no controller
+/// avoids entirely (N m; issue 37).
+pub const NOISY_TORQUE_ALLOWANCE: f64 = 0.1;
+
+/// The torque allowance of a case ([`TORQUE_ALLOWANCE`], or
+/// [`NOISY_TORQUE_ALLOWANCE`] where it adds noise).
+pub fn torque_allowance(perturbation: Perturbation) -> f64 {
+    match perturbation {
+        Perturbation::MeasurementNoise { .. }
+        | Perturbation::TorqueNoise(_)
+        | Perturbation::RoughModelNoisy(_) => NOISY_TORQUE_ALLOWANCE,
+        _ => TORQUE_ALLOWANCE,
+    }
+}
+
+/// The rough models' largest relative error of each mass, centre-of-mass
+/// distance and inertia.
+pub const ROUGH_MODEL_ERROR: f64 = 0.2;
+
+/// The rough models' sensors: noise of the angles (rad) and of the speeds
+/// (rad/s), the laboratory robots' own.
+pub const ROUGH_NOISE: (f64, f64) = (0.005, 0.05);
+
+/// Rough model number `index` of `nominal`, as a user's CAD model is: each
+/// link's mass, centre-of-mass distance and inertia about its centre of
+/// mass times its own factor, uniform in 1 +- [`ROUGH_MODEL_ERROR`]
+/// (seeded by the number, the same on every machine), and no friction (it
+/// is unknown).
+pub fn rough_model<const N: usize>(
+    nominal: &PlanarChainParams<N>,
+    index: u64,
+) -> PlanarChainParams<N> {
+    let mut rng = GaussianNoise::new(0x0ac0_0000_0000 + index);
+    let mut p = *nominal;
+    let mut factor = || 1.0 + ROUGH_MODEL_ERROR * (2.0 * rng.uniform() - 1.0);
+    for link in &mut p.links {
+        link.mass *= factor();
+        link.com *= factor();
+        link.inertia *= factor();
+    }
+    for joint in &mut p.joints {
+        joint.viscous = 0.0;
+        joint.coulomb = 0.0;
+    }
+    p
+}
 
 /// Scored window at the end of every run (s).
 pub const SCORED_WINDOW: f64 = 5.0;
@@ -138,7 +195,7 @@ pub const MAX_MEASUREMENT_NOISE: (f64, f64) = (0.01, 0.1);
 pub const MAX_TORQUE_NOISE: f64 = 0.2;
 
 /// Range of the torque response `a`.
-pub const RESPONSE_RANGE: (f64, f64) = (0.25, 2.0);
+pub const RESPONSE_RANGE: (f64, f64) = (0.1, 2.0);
 
 /// Largest measurement delay (s).
 pub const MAX_DELAY: f64 = 0.04;
@@ -325,6 +382,15 @@ pub fn default_cases<const N: usize>(
             Perturbation::TorquePulses(k),
         );
     }
+    for k in 1..=sweep.steps as u64 {
+        push(
+            "rough model + noise",
+            "model".into(),
+            k as f64,
+            "model",
+            Perturbation::RoughModelNoisy(k),
+        );
+    }
     cases
 }
 
@@ -428,6 +494,10 @@ pub fn plant_and_imperfections<const N: usize>(
             imperfections.delay_fraction = if fraction > 1e-9 { fraction } else { 0.0 };
         }
         Perturbation::TorquePulses(_) => {}
+        Perturbation::RoughModelNoisy(_) => {
+            imperfections.measurement_noise = ROUGH_NOISE.0;
+            imperfections.speed_noise = Some(ROUGH_NOISE.1);
+        }
     }
     (p, imperfections)
 }
@@ -446,6 +516,11 @@ pub struct Setup<const N: usize> {
     /// The filter is told the case's measurement noise (at least
     /// [`EKF_NOISE_FLOOR`]).
     pub ekf: bool,
+    /// The controller is told the case's motor response and measurement
+    /// delay (`torque_response`, `measurement_delay`), as its filter is
+    /// told the sensors' noise; without, it assumes an immediate motor and
+    /// a current measurement (robustness to them unmodelled).
+    pub declared: bool,
 }
 
 /// Noise level the filter assumes for a clean sensor (rad, rad/s).
@@ -472,6 +547,7 @@ impl<const N: usize> Setup<N> {
             q0: Vector::<N>::repeat(START_ANGLE),
             duration,
             ekf: false,
+            declared: true,
         })
     }
 }
@@ -491,6 +567,8 @@ pub struct Outcome {
     pub rms_torque: Vec<f64>,
     /// RMS friction torque of the plant along the last 5 s, per joint (N m).
     pub friction_torque: Vec<f64>,
+    /// The torque allowed above the friction torque (N m, [`torque_allowance`]).
+    pub allowance: f64,
     /// The controller ran its extended Kalman filter.
     pub ekf: bool,
     /// Samples whose solve did not succeed.
@@ -501,15 +579,20 @@ pub struct Outcome {
 
 /// The score rule: the mean energy of the scored window within
 /// [`ENERGY_TOLERANCE`] of `E_ref` (`energy_error` relative) and, per
-/// joint, the RMS torque at most the friction torque plus
-/// [`TORQUE_ALLOWANCE`]. Anything not finite fails.
-pub fn succeeds(energy_error: f64, rms_torque: &[f64], friction_torque: &[f64]) -> bool {
+/// joint, the RMS torque at most the friction torque plus `allowance`
+/// ([`torque_allowance`]). Anything not finite fails.
+pub fn succeeds(
+    energy_error: f64,
+    rms_torque: &[f64],
+    friction_torque: &[f64],
+    allowance: f64,
+) -> bool {
     energy_error.abs() <= ENERGY_TOLERANCE
         && rms_torque.len() == friction_torque.len()
         && rms_torque
             .iter()
             .zip(friction_torque)
-            .all(|(tau, friction)| *tau <= friction + TORQUE_ALLOWANCE)
+            .all(|(tau, friction)| *tau <= friction + allowance)
 }
 
 /// RMS per joint of `torque` over the samples of the last `window` s of
@@ -551,6 +634,9 @@ pub fn run_case<const N: usize, const S: usize, const NP: usize>(
     let plant = PlanarChain::new(plant).map_err(|e| format!("{}: {e}", case.parameter))?;
     let mut settings = setup.settings.clone();
     settings.adapt = adapt;
+    if let Perturbation::RoughModelNoisy(k) = case.perturbation {
+        settings.model = ChainParameters::from_params(&rough_model(&nominal, k))?;
+    }
     let noisy = imperfections.measurement_noise > 0.0 || imperfections.speed_noise() > 0.0;
     let ekf = setup.ekf || noisy;
     if ekf {
@@ -559,10 +645,15 @@ pub fn run_case<const N: usize, const S: usize, const NP: usize>(
         settings.noise.angle_noise = imperfections.measurement_noise.max(EKF_NOISE_FLOOR);
         settings.noise.speed_noise = imperfections.speed_noise().max(EKF_NOISE_FLOOR);
     }
+    if setup.declared {
+        settings.torque_response = imperfections.responsiveness;
+        settings.measurement_delay =
+            (imperfections.delay_samples as f64 + imperfections.delay_fraction) * dt;
+    }
     let mut controller = settings.build::<S>()?;
     let mut adaptation = if adapt {
         Some(
-            Adaptation::<N, S, NP>::new(&nominal, settings.adapt_options())
+            Adaptation::<N, S, NP>::new(&settings.model.params(), settings.adapt_options())
                 .map_err(|e| e.to_string())?,
         )
     } else {
@@ -592,8 +683,10 @@ pub fn run_case<const N: usize, const S: usize, const NP: usize>(
     let energy_error = (mean - e_ref) / e_ref;
     let rms_torque = rms_tail(&run.samples, &run.motor_torque, SCORED_WINDOW);
     let friction_torque: Vec<f64> = friction.iter().copied().collect();
+    let allowance = torque_allowance(case.perturbation);
     Ok(Outcome {
-        success: succeeds(energy_error, &rms_torque, &friction_torque),
+        success: succeeds(energy_error, &rms_torque, &friction_torque, allowance),
+        allowance,
         time_to_band: summary.time_to_5_percent,
         energy_error,
         rms_torque,
@@ -654,9 +747,10 @@ mod tests {
             ("rotor inertia", 21, 0.0, 0.05),
             ("measurement noise", 21, 0.0, 0.01),
             ("torque noise", 21, 0.0, 0.2),
-            ("torque response", 21, 0.25, 2.0),
+            ("torque response", 21, 0.1, 2.0),
             ("measurement delay", 21, 0.0, 0.04),
             ("torque pulses", 50, 1.0, 50.0),
+            ("rough model + noise", 21, 1.0, 21.0),
         ] {
             let cases = of(&paper, category);
             assert_eq!(cases.len(), n, "{category}");
@@ -798,13 +892,64 @@ mod tests {
     fn score_rule_thresholds() {
         let friction = [0.05, 0.0];
         let inside = [0.05 + 0.0299, 0.0299];
-        assert!(succeeds(0.0099, &inside, &friction));
-        assert!(succeeds(-0.0099, &inside, &friction));
-        assert!(!succeeds(0.0101, &inside, &friction));
-        assert!(!succeeds(-0.0101, &inside, &friction));
-        assert!(!succeeds(0.0, &[0.05 + 0.0301, 0.0], &friction));
-        assert!(!succeeds(0.0, &[0.0, 0.0301], &friction));
-        assert!(!succeeds(f64::NAN, &inside, &friction));
-        assert!(!succeeds(0.0, &[f64::NAN, 0.0], &friction));
+        assert!(succeeds(0.0099, &inside, &friction, TORQUE_ALLOWANCE));
+        assert!(succeeds(-0.0099, &inside, &friction, TORQUE_ALLOWANCE));
+        assert!(!succeeds(0.0101, &inside, &friction, TORQUE_ALLOWANCE));
+        assert!(!succeeds(-0.0101, &inside, &friction, TORQUE_ALLOWANCE));
+        assert!(!succeeds(
+            0.0,
+            &[0.05 + 0.0301, 0.0],
+            &friction,
+            TORQUE_ALLOWANCE
+        ));
+        assert!(!succeeds(0.0, &[0.0, 0.0301], &friction, TORQUE_ALLOWANCE));
+        assert!(!succeeds(f64::NAN, &inside, &friction, TORQUE_ALLOWANCE));
+        assert!(!succeeds(
+            0.0,
+            &[f64::NAN, 0.0],
+            &friction,
+            TORQUE_ALLOWANCE
+        ));
+        // Under noise 0.1 N m above the friction.
+        assert!(succeeds(
+            0.0,
+            &[0.05 + 0.0999, 0.0],
+            &friction,
+            NOISY_TORQUE_ALLOWANCE
+        ));
+        assert!(!succeeds(
+            0.0,
+            &[0.05 + 0.1001, 0.0],
+            &friction,
+            NOISY_TORQUE_ALLOWANCE
+        ));
+        assert_eq!(
+            torque_allowance(Perturbation::TorqueNoise(0.1)),
+            NOISY_TORQUE_ALLOWANCE
+        );
+        assert_eq!(
+            torque_allowance(Perturbation::Delay(0.01)),
+            TORQUE_ALLOWANCE
+        );
+    }
+
+    /// The rough models are seeded, within their error, without friction,
+    /// and differ from each other.
+    #[test]
+    fn rough_models_are_seeded_and_bounded() {
+        let nominal = lab_a0();
+        let a = rough_model(&nominal, 3);
+        assert_eq!(a, rough_model(&nominal, 3));
+        assert_ne!(a, rough_model(&nominal, 4));
+        for (r, n) in a.links.iter().zip(&nominal.links) {
+            for (x, y) in [(r.mass, n.mass), (r.com, n.com), (r.inertia, n.inertia)] {
+                assert!((x / y - 1.0).abs() <= ROUGH_MODEL_ERROR, "{x} vs {y}");
+            }
+        }
+        assert!(
+            a.joints
+                .iter()
+                .all(|j| j.viscous == 0.0 && j.coulomb == 0.0)
+        );
     }
 }

@@ -43,7 +43,10 @@ state when it arrives: the controller predicts it forward with its model and the
 sent since (the state estimator filters it at its own time). <code>actuator_time_constant</code> \
 (s) declares a first-order lag of the motor: integrated exactly over the delay, taken as a dead \
 time over the horizon. A declared delay of 4 samples or lag of 2 costs nothing measurable on the \
-paper's scenario (docs/delay.md).</p>\
+paper's scenario (docs/delay.md). <code>torque_response</code> declares instead a motor that \
+moves per sample by a times the distance to the command (u += a (tau - u), a in (0, 2]): the \
+plan's controls are then the applied torques, and tau is the command that makes the motor apply \
+the first one (an overshooting motor, 1 &lt; a &lt;= 2, is cancelled exactly).</p>\
 <p><b>Refused values.</b> A value out of range (or NaN/Inf) is refused with fmi2Error; the old \
 value stays in place and readable, and the instance is in the FMI error state: call \
 fmi2Reset to continue.</p>"

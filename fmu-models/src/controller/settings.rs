@@ -160,6 +160,9 @@ pub struct Settings<const N: usize> {
     /// Time constant of the actuator's first-order lag (s; see
     /// [`MpcConfig::actuator_time_constant`]).
     pub actuator_time_constant: f64,
+    /// The motor's response per sample `u += a (tau - u)` (1: immediate;
+    /// see [`MpcConfig::torque_response`]).
+    pub torque_response: f64,
     /// The stall supervisor ([`eigenmpc::mpc::SupervisorOptions`]): a
     /// joint held still at a large torque, off the target energy, gets its
     /// torque released.
@@ -212,6 +215,7 @@ impl<const N: usize> Settings<N> {
             adapt_realtime: false,
             measurement_delay: config.measurement_delay,
             actuator_time_constant: config.actuator_time_constant,
+            torque_response: config.torque_response,
             supervisor: config.supervisor.enabled,
         }
     }
@@ -240,6 +244,7 @@ impl<const N: usize> Settings<N> {
         };
         config.measurement_delay = self.measurement_delay;
         config.actuator_time_constant = self.actuator_time_constant;
+        config.torque_response = self.torque_response;
         config.supervisor.enabled = self.supervisor;
         config
     }

@@ -256,6 +256,7 @@ pub fn table<const N: usize>() -> Table<Settings<N>> {
     rows.extend(compensation_rows::<N>());
     rows.extend(adaptation_outcome_rows::<N>());
     rows.extend(supervisor_rows::<N>());
+    rows.extend(response_rows::<N>());
     Table::new(N, rows)
 }
 
@@ -542,5 +543,27 @@ fn estimator_rows<const N: usize>() -> Vec<Rw<N>> {
             "unmodelled acceleration per joint, constant over a sample (larger trusts the \
              measurement more, smaller the model)",
         ),
+    ]
+}
+
+/// The motor's response per sample (issue 37; after the supervisor's rows:
+/// the older value references stay).
+fn response_rows<const N: usize>() -> Vec<Rw<N>> {
+    vec![
+        Rw::<N>::real("torque_response", Shape::Scalar)
+            .parameter(Field::real(
+                |s, _| s.torque_response,
+                |s, _, v| s.torque_response = v,
+            ))
+            .range(0.0, 2.0)
+            .range_text("(0, 2]")
+            .describe(
+                "The motor's response per sample, u += a (tau - u): the torque applied over a \
+                 sample moves from the last one's by a times its distance to the command (1: \
+                 immediate; a < 1 lags, 1 < a <= 2 overshoots). The plan's controls are the \
+                 applied torques, bounded per stage by what the motor reaches; tau is the \
+                 command that makes the motor apply the plan's first. Not together with \
+                 actuator_time_constant",
+            ),
     ]
 }
