@@ -13,7 +13,8 @@
 //! 52 held a torque at its bound without motion for 22 s and ended 92 %
 //! low (a loop off its target for 30 s then has the adaptation try its
 //! estimate, which got two others out; with the identification's 1 s
-//! windows it now gets model 52 out too, after a 19.4 s stall). With the
+//! windows it now gets model 52 out too, after a 19.4 s stall, and 8.4 s
+//! since the off-target count is taken on the energy error's 2 s mean). With the
 //! supervisor, 52 of
 //! the 53 valid models of that search end within 2 % (the other -2.3 %),
 //! and every one of the same search on A0.
@@ -130,8 +131,9 @@ fn check(plant_file: &str, factors: [f64; 5], e_ref: f64) {
     );
     // The stall is there without the supervisor (the test can fail). (How
     // the run ends without it varies: the adaptation tries its estimate
-    // after 30 s off the band, which ends the B0 stall after 19.4 s.)
-    assert!(longest_stall(&without) > 10.0, "no stall to recover from");
+    // after 30 s off the band, which ends the B0 stall after 8.4 s; 19.4 s
+    // while a limit cycle's passes through the band reset that count.)
+    assert!(longest_stall(&without) > 5.0, "no stall to recover from");
     // ...and gone with it: released, and the adaptation takes the model
     // the motion before the stall identified.
     assert!(stalls >= 1);
