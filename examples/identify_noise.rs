@@ -5,11 +5,14 @@
 //! inertias 10-20 % off, no friction) and is fed the measurements and the
 //! torque, as the adaptation feeds it. Printed: the identified model's
 //! energy error along the plant's orbit (the second half of the run, a
-//! share of E_ref), mean and standard deviation over 4 noise seeds, for the
-//! default windows and for the windows of before (20 samples, ends of 5).
+//! share of E_ref), its mean and the mean's standard deviation over 4 noise
+//! seeds, and its RMS about the mean, for the default window ends (their
+//! length chosen from the measured noise) and for fixed ends of 40 and 5.
 //!
 //! On an orbit the energy scale has almost no signal, so noise in the
-//! windows' ends (the regressors) shrinks it: errors in variables.
+//! windows' ends (the regressors) shrinks it: errors in variables. Long
+//! ends average that noise but blur the orbit's exchange of kinetic and
+//! potential energy, which gives the parameters' ratios.
 //! Run with `cargo run --release --example identify_noise`.
 
 use eigenmpc::identify::{BaseParameters, EnergyBalanceRls, RlsOptions, energy_features};
@@ -40,14 +43,16 @@ fn rough(robot: &PlanarChainParams<2>) -> PlanarChainParams<2> {
     p
 }
 
-/// The identified model's mean energy error along the second half of one
-/// seeded closed loop, per window setting (a share of E_ref).
+/// The identified model's energy error along the second half of one
+/// seeded closed loop, per window setting (shares of E_ref): its mean (the
+/// energy scale) and its RMS about the mean (the ratios: a model with the
+/// right energy on average but wrong ratios swings about it).
 fn orbit_errors(
     robot: &PlanarChainParams<2>,
     noise: (f64, f64),
     seed: u64,
     settings: &[RlsOptions],
-) -> Vec<f64> {
+) -> Vec<(f64, f64)> {
     let plant = PlanarChain::new(*robot).unwrap();
     let (mut controller, _) =
         robot_controller::<2, 4>(&plant, Variant::Curved, E_REF, 0.5).unwrap();
@@ -82,16 +87,18 @@ fn orbit_errors(
             }
             let error = rls.estimate().theta - truth;
             let orbit = &trace[trace.len() / 2..];
-            orbit
+            let errors: Vec<f64> = orbit
                 .iter()
                 .map(|s| {
                     let q = Vector::<2>::new(s.state[0], s.state[1]);
                     let qd = Vector::<2>::new(s.state[2], s.state[3]);
-                    error.dot(&energy_features::<2, 11>(&prior, &q, &qd))
+                    error.dot(&energy_features::<2, 11>(&prior, &q, &qd)) / E_REF
                 })
-                .sum::<f64>()
-                / orbit.len() as f64
-                / E_REF
+                .collect();
+            let n = errors.len() as f64;
+            let mean = errors.iter().sum::<f64>() / n;
+            let spread = (errors.iter().map(|e| (e - mean).powi(2)).sum::<f64>() / n).sqrt();
+            (mean, spread)
         })
         .collect()
 }
@@ -102,32 +109,39 @@ fn main() {
         "/robots/lab-double-pendulum-A0.yml"
     );
     let robot = RobotFile::load(path).unwrap().params::<2>().unwrap();
-    let settings = [
-        RlsOptions::default(),
-        RlsOptions {
-            window: 20,
-            end_samples: 5,
-            ..RlsOptions::default()
-        },
-    ];
+    let fixed = |ends: usize| RlsOptions {
+        end_samples: ends,
+        min_end_samples: ends,
+        ..RlsOptions::default()
+    };
+    let settings = [RlsOptions::default(), fixed(40), fixed(5)];
     println!(
         "A0, exact controller, rough prior, 120 s closed loop: the identified model's energy error \
          along the orbit (mean ± sd over {SEEDS} seeds)"
     );
+    println!("(each cell: the mean error ± its sd over the seeds; the RMS about the mean)");
     println!(
-        "| noise (rad, rad/s) | windows of 40, ends of 40 (default) | windows of 20, ends of 5 |"
+        "| noise (rad, rad/s) | ends from the noise, 5-40 (default) | ends of 40 | ends of 5 |"
     );
-    println!("|---|---|---|");
+    println!("|---|---|---|---|");
     for noise in [(0.0, 0.0), (0.005, 0.05), (0.01, 0.1)] {
-        let runs: Vec<Vec<f64>> = (1..=SEEDS)
+        let runs: Vec<Vec<(f64, f64)>> = (1..=SEEDS)
             .map(|seed| orbit_errors(&robot, noise, seed, &settings))
             .collect();
         let cell = |k: usize| {
-            let e: Vec<f64> = runs.iter().map(|r| 100.0 * r[k]).collect();
+            let e: Vec<f64> = runs.iter().map(|r| 100.0 * r[k].0).collect();
             let mean = e.iter().sum::<f64>() / e.len() as f64;
             let sd = (e.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / e.len() as f64).sqrt();
-            format!("{mean:+.2} % ± {sd:.2}")
+            let spread = runs.iter().map(|r| 100.0 * r[k].1).sum::<f64>() / e.len() as f64;
+            format!("{mean:+.2} % ± {sd:.2}; {spread:.2} %")
         };
-        println!("| {} / {} | {} | {} |", noise.0, noise.1, cell(0), cell(1));
+        println!(
+            "| {} / {} | {} | {} | {} |",
+            noise.0,
+            noise.1,
+            cell(0),
+            cell(1),
+            cell(2)
+        );
     }
 }

@@ -232,7 +232,10 @@ pub enum AdaptationEvent {
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 struct Request<const N: usize> {
     params: PlanarChainParams<N>,
-    family: Option<(FamilyOptions, usize)>,
+    /// The family's options, mode and the energy the controller runs at
+    /// (the charts about it are refitted to a higher degree when they miss
+    /// the new model's orbits: [`ChartFamily::compute_accurate`]).
+    family: Option<(FamilyOptions, usize, f64)>,
     /// The controller's shooting interval (for the prediction substeps).
     dt: f64,
 }
@@ -776,7 +779,7 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
                     FamilyOptions::for_system(&chain, &[controller.config().cost.e_ref])
                 };
                 options.degree = family.degree();
-                Some((options, family.mode_index()))
+                Some((options, family.mode_index(), controller.config().cost.e_ref))
             }
             None => None,
         };
@@ -1147,8 +1150,8 @@ fn work<const N: usize, const NX: usize>(shared: &(Mutex<Slot<N>>, Condvar)) {
                         prediction_model(&model, request.dt, PREDICTION_SUBSTEPS);
                     match &request.family {
                         None => Some((model, None, substeps)),
-                        Some((options, mode)) => {
-                            ChartFamily::compute::<_, NX>(&model, *mode, options)
+                        Some((options, mode, energy)) => {
+                            ChartFamily::compute_accurate::<_, NX>(&model, *mode, options, *energy)
                                 .ok()
                                 .map(|family| (model, Some(family), substeps))
                         }

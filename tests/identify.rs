@@ -394,3 +394,53 @@ fn every_joint_count_identifies_with_the_default_settings() {
     starts::<6, 45>();
     assert!(RlsOptions::default().residual_windows >= base_parameter_count(2) + RESIDUAL_DOF);
 }
+
+#[test]
+fn the_window_ends_follow_the_measured_noise() {
+    // Exact sensors: the balance's fourth differences show only the
+    // integration and the motion, mostly the kinks of the Coulomb friction
+    // that the rough prior lacks at each reversal (5.5e-4 of this small
+    // forced motion's RMS energy; 2e-5 on A0's 2 J orbit), so the ends stay
+    // short and keep the motion's detail. The lab's sensors (0.005 rad, and
+    // here 0.005 rad/s): the ends average the whole window, which keeps the
+    // noise from shrinking the energy scale.
+    let defaults = RlsOptions::default();
+    let (quiet, _) = identify_a0(0.0, 20.0);
+    let relative = quiet.relative_noise().unwrap();
+    eprintln!("exact: relative noise {relative:.2e}");
+    assert!(relative < 0.7 * defaults.quiet_noise, "{relative}");
+    assert_eq!(quiet.end_samples(), defaults.min_end_samples);
+    let (noisy, windows) = identify_a0(0.005, 20.0);
+    let relative = noisy.relative_noise().unwrap();
+    eprintln!("0.005: relative noise {relative:.2e}");
+    assert!(relative > 3.0 * defaults.quiet_noise, "{relative}");
+    assert_eq!(noisy.end_samples(), defaults.end_samples);
+    // Every window since the first block has the long ends: the window
+    // variance the identification gives them is calibrated (see above).
+    assert!(windows.len() >= 15);
+}
+
+#[test]
+fn window_ends_outside_their_range_are_refused() {
+    for (window, ends, min) in [(40, 40, 0), (40, 5, 10), (20, 40, 5)] {
+        let options = RlsOptions {
+            window,
+            end_samples: ends,
+            min_end_samples: min,
+            ..RlsOptions::default()
+        };
+        let message = options.validate().unwrap_err().to_string();
+        assert!(message.contains("min_end_samples"), "{message}");
+    }
+    let options = RlsOptions {
+        quiet_noise: 0.0,
+        ..RlsOptions::default()
+    };
+    assert!(
+        options
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("quiet_noise")
+    );
+}

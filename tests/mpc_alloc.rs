@@ -152,6 +152,30 @@ fn control_steps_do_not_allocate() {
     let total = OURS.load(Ordering::SeqCst) + BACKEND.load(Ordering::SeqCst) - before;
     assert_eq!(total, 0, "family controller allocated {total} times");
 
+    // A model's family of a higher degree (the adaptation refits a curved
+    // mode's charts, `ChartFamily::compute_accurate`) is written into the
+    // chart the controller has, without allocating.
+    let higher = ChartFamily::compute::<_, 4>(
+        &sys,
+        0,
+        &FamilyOptions {
+            degree: 13,
+            ..FamilyOptions::up_to(20.0)
+        },
+    )
+    .unwrap();
+    let before = OURS.load(Ordering::SeqCst) + BACKEND.load(Ordering::SeqCst);
+    let old = ctrl.replace_model(sys, Some(higher)).unwrap();
+    for _ in 0..10 {
+        let out = ctrl.step(&z);
+        assert!(out.status.is_ok());
+        z = eigenmpc::integrate::rk4_step::<_, 2, 4>(&sys, &z, &out.tau, 0.025);
+    }
+    let total = OURS.load(Ordering::SeqCst) + BACKEND.load(Ordering::SeqCst) - before;
+    assert_eq!(total, 0, "a degree-13 family allocated {total} times");
+    assert_eq!(ctrl.reference().chart().unwrap().degree, 13);
+    drop(old);
+
     // With the state estimator: predict and correct allocate nothing.
     let (_, chart) = mode_and_chart::<_, 2, 4>(&sys, 0, 14.0, 9).unwrap();
     let mut config = MpcConfig::paper(Variant::Curved);

@@ -13,7 +13,7 @@ pub use eigenmode::{
     ContinuationOptions, Eigenmode, continue_family, eigenmode_family,
     eigenmode_family_with_progress,
 };
-pub use family::{ChartFamily, FamilyOptions};
+pub use family::{CHART_TOLERANCE, ChartFamily, FamilyOptions, MAX_FAMILY_DEGREE};
 pub use linear::{Family, LinearMode, linear_modes};
 
 use crate::integrate::IntegrationError;

@@ -217,19 +217,27 @@ where
     }
 
     /// Replaces the controller's model (an identified one, say) and, for a
-    /// controller on a mode family, the family computed for it (same chart
-    /// degree); the plan is kept as the warm start. Returns the old family,
-    /// so that the caller can drop it outside a real-time path; nothing is
-    /// allocated here.
+    /// controller on a mode family, the family computed for it (its chart
+    /// degree may differ, up to what the controller's chart has room for:
+    /// [`crate::modes::MAX_FAMILY_DEGREE`] for a controller made
+    /// [`Controller::with_family`]); the plan is kept as the warm start.
+    /// Returns the old family, so that the caller can drop it outside a
+    /// real-time path; nothing is allocated here.
     pub fn replace_model(
         &mut self,
         system: S,
         family: Option<ChartFamily<N>>,
     ) -> Result<Option<ChartFamily<N>>, MpcError> {
         match (&family, self.reference.chart()) {
-            (Some(f), Some(chart)) if f.degree() != chart.degree => {
+            (Some(f), Some(chart))
+                if chart
+                    .coefficients
+                    .iter()
+                    .any(|c| c.capacity() <= f.degree()) =>
+            {
                 return Err(MpcError::InvalidReference(format!(
-                    "the new family's charts have degree {}, the controller's {}",
+                    "the new family's charts have degree {}, more than the controller's chart \
+                     (degree {}) has room for",
                     f.degree(),
                     chart.degree
                 )));
