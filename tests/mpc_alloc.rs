@@ -176,6 +176,22 @@ fn control_steps_do_not_allocate() {
     assert_eq!(ctrl.reference().chart().unwrap().degree, 13);
     drop(old);
 
+    // A state saved with a degree-9 chart and restored has the same room:
+    // a degree-13 family goes into it without allocating.
+    let nine = ChartFamily::compute::<_, 4>(&sys, 0, &FamilyOptions::up_to(20.0)).unwrap();
+    let thirteen = ctrl.replace_model(sys, Some(nine)).unwrap();
+    let saved = ctrl.save_state();
+    ctrl.restore_state(saved).unwrap();
+    assert_eq!(ctrl.reference().chart().unwrap().degree, 9);
+    let before = OURS.load(Ordering::SeqCst) + BACKEND.load(Ordering::SeqCst);
+    let old = ctrl.replace_model(sys, thirteen).unwrap();
+    let out = ctrl.step(&z);
+    assert!(out.status.is_ok());
+    let total = OURS.load(Ordering::SeqCst) + BACKEND.load(Ordering::SeqCst) - before;
+    assert_eq!(total, 0, "a family after a restore allocated {total} times");
+    assert_eq!(ctrl.reference().chart().unwrap().degree, 13);
+    drop(old);
+
     // With the state estimator: predict and correct allocate nothing.
     let (_, chart) = mode_and_chart::<_, 2, 4>(&sys, 0, 14.0, 9).unwrap();
     let mut config = MpcConfig::paper(Variant::Curved);

@@ -120,6 +120,14 @@ where
         self.config = config;
         self.set_system(state.system);
         self.reference = state.reference;
+        if let Some(chart) = self.reference.chart_mut() {
+            // Room for a family of any degree, as `ChartFamily::chart`
+            // makes it (a restored chart has only its own): a model
+            // swapped in later writes into it without allocating.
+            for c in chart.coefficients.iter_mut() {
+                c.reserve(crate::modes::MAX_FAMILY_DEGREE.saturating_sub(c.len()) + 1);
+            }
+        }
         self.family = state.family;
         self.xs = state.xs;
         self.us = state.us;
