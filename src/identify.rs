@@ -758,9 +758,11 @@ impl<const N: usize, const NP: usize> EnergyBalanceRls<N, NP> {
     }
 
     /// Samples the next end block averages: `min_end_samples` while the
-    /// balance's white noise per sample (its fourth differences,
-    /// [`NoiseEstimate`]) is at most `quiet_noise` of the motion's RMS
-    /// energy, growing with the noise's variance up to `end_samples`.
+    /// balance's white noise per sample (read off the fourth differences of
+    /// its running residual under the prior's parameters,
+    /// [`EnergyBalanceRls::relative_noise`]) is at most `quiet_noise` of
+    /// the motion's RMS energy, growing with the noise's variance up to
+    /// `end_samples`.
     /// Measured (120 s closed loops of the lab pendulum A0 at 1-2 J): ends of 5
     /// let sensor noise of 0.005 rad / 0.05 rad/s shrink the identified
     /// energy along the orbit by 34 %, ends of 40 by 1.5 %; but on exact
