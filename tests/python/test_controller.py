@@ -571,7 +571,10 @@ def test_a_stall_under_noise_and_the_ekf_is_seen_and_released(
     torque bounds; the supervisor watched the estimate and saw no stall
     (111.7 s at the bounds, -73 %). It now judges motion on the
     measurement: released within 2 s, and the run ends within 2 % with the
-    torque near the friction torque."""
+    torque near the friction torque. Without the supervisor the motors are
+    still held at their bounds for far longer than 2 s: for the whole run
+    before the identification's prior was narrowed under noise, 24 s since
+    (its next model frees the pendulum, and the run ends 2.6 % low)."""
     runs = {}
     for supervisor in (False, True):
         rng = np.random.default_rng(37)
@@ -595,7 +598,7 @@ def test_a_stall_under_noise_and_the_ekf_is_seen_and_released(
         f"{friction[0]:.4f} / {friction[1]:.4f}, {last['supervisor_events']} stalls, "
         f"{last['model_updates']} models"
     )
-    assert stall_off > 30.0 and e_off < 0.7
+    assert stall_off > 10.0
     assert stall_on <= 2.0
     assert abs(e_on - 1.0) < 0.02
     assert last["supervisor_events"] >= 1
