@@ -801,10 +801,9 @@ impl<const N: usize, const NP: usize> EnergyBalanceRls<N, NP> {
     /// one case in six).
     pub fn end_samples(&self) -> usize {
         let o = &self.options;
-        let Some(relative) = self.relative_noise().filter(|r| r.is_finite()) else {
+        let Some(ratio) = self.measured_noise_ratio() else {
             return o.end_samples;
         };
-        let ratio = relative / o.quiet_noise;
         let wanted = o.min_end_samples as f64 * ratio * ratio;
         if wanted >= o.end_samples as f64 {
             o.end_samples
@@ -821,11 +820,16 @@ impl<const N: usize, const NP: usize> EnergyBalanceRls<N, NP> {
     }
 
     /// The balance's white noise against quiet sensors' (`relative_noise /
-    /// quiet_noise`, at least 1; 1 until measured).
-    fn noise_ratio(&self) -> f64 {
+    /// quiet_noise`); `None` until measured.
+    fn measured_noise_ratio(&self) -> Option<f64> {
         self.relative_noise()
             .filter(|r| r.is_finite())
-            .map_or(1.0, |r| (r / self.options.quiet_noise).max(1.0))
+            .map(|r| r / self.options.quiet_noise)
+    }
+
+    /// [`Self::measured_noise_ratio`], at least 1 (1 until measured).
+    fn noise_ratio(&self) -> f64 {
+        self.measured_noise_ratio().map_or(1.0, |r| r.max(1.0))
     }
 
     /// The prior's information on parameter `i` (1 / its variance) when the
@@ -861,11 +865,13 @@ impl<const N: usize, const NP: usize> EnergyBalanceRls<N, NP> {
             return information;
         }
         let quiet = information.recip().sqrt();
-        let relative = if i < N * (N + 1) / 2 {
+        type B<const N: usize, const NP: usize> = BaseParameters<N, NP>;
+        // The blocks of the base parameters: A_jl, G_j, Ir_j, b_j, cf_j.
+        let relative = if i < B::<N, NP>::g_index(0) {
             self.options.inertia_relative
-        } else if (0..N).any(|j| BaseParameters::<N, NP>::rotor_index(j) == i) {
+        } else if (B::<N, NP>::rotor_index(0)..B::<N, NP>::viscous_index(0)).contains(&i) {
             self.options.rotor_relative
-        } else if (0..N).any(|j| BaseParameters::<N, NP>::viscous_index(j) == i) {
+        } else if (B::<N, NP>::viscous_index(0)..B::<N, NP>::coulomb_index(0)).contains(&i) {
             0.0
         } else {
             return information;
