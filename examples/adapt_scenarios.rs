@@ -8,6 +8,7 @@
 //! `cargo run --release --example adapt_scenarios [-- ROW]`
 
 use eigenmpc::adapt::{AdaptOptions, Adaptation};
+use eigenmpc::identify::RlsOptions;
 use eigenmpc::mechanics::{PlanarChain, PlanarChainParams};
 use eigenmpc::model_file::RobotFile;
 use eigenmpc::modes::{ChartFamily, FamilyOptions};
@@ -190,11 +191,21 @@ fn run(row: &Row, adapt: bool) -> String {
             acceleration_noise: 1.0,
         });
     }
+    // The identification is told the noise the EKF is told, as in the FMU.
+    let rls = match &config.estimator {
+        Some(e) => RlsOptions {
+            angle_noise: e.angle_noise,
+            speed_noise: e.speed_noise,
+            ..RlsOptions::default()
+        },
+        None => RlsOptions::default(),
+    };
     let mut controller = Controller::<_, 2, 4>::with_family(model, config, family).unwrap();
     let mut adaptation = Adaptation::<2, 4, 11>::new(
         &row.model,
         AdaptOptions {
             synchronous: true,
+            rls,
             ..AdaptOptions::default()
         },
     )

@@ -574,7 +574,7 @@ def test_a_stall_under_noise_and_the_ekf_is_seen_and_released(
     torque near the friction torque. Without the supervisor the motors are
     still held at their bounds for far longer than 2 s: for the whole run
     before the identification's prior was narrowed under noise, 24 s since
-    (its next model frees the pendulum; the run ends 9 % low)."""
+    (its next model frees the pendulum; the run ends 8 % low)."""
     runs = {}
     for supervisor in (False, True):
         rng = np.random.default_rng(37)

@@ -5,6 +5,7 @@
 use super::precomputed::PrecomputedFamily;
 use crate::chain::{ChainParameters, HasChain};
 use eigenmpc::adapt::AdaptOptions;
+use eigenmpc::identify::RlsOptions;
 use eigenmpc::mechanics::{MechanicalSystem, PlanarChain, Vector};
 use eigenmpc::modes::{Chart, ChartFamily, FamilyOptions, linear_modes};
 use eigenmpc::mpc::{
@@ -226,7 +227,22 @@ impl<const N: usize> Settings<N> {
             period: ((self.adapt_period / self.sample_period).round() as usize).max(1),
             family_energy_max: self.family_energy_max,
             synchronous: !self.adapt_realtime,
+            rls: self.rls_options(),
             ..AdaptOptions::default()
+        }
+    }
+
+    /// The identification's settings: the sensors' noise as the state
+    /// estimator is told it (none without the estimator).
+    fn rls_options(&self) -> RlsOptions {
+        let rls = RlsOptions::default();
+        match self.state_estimator {
+            StateEstimator::None => rls,
+            StateEstimator::Ekf => RlsOptions {
+                angle_noise: self.noise.angle_noise,
+                speed_noise: self.noise.speed_noise,
+                ..rls
+            },
         }
     }
 
