@@ -450,7 +450,7 @@ pub struct RlsOptions {
     /// noise -1.1 %, +1.7 %, +4.6 %. The robustness report's rough model +
     /// noise (A0 at 2 J and B0 at 1.5 J, adaptation, 120 s; runs within 2 %
     /// of 21 each): none 14 and 9, half 19 and 8, all 20 and 8; the stalling
-    /// rough model of A0 under noise (`tests/python`) ended -1.5 %, -0.5 %
+    /// rough model of A0 under noise (`tests/python`) ended -1.5 %, -0.02 %
     /// and -2.2 %.
     #[serde(default = "default_noise_compensation")]
     pub noise_compensation: f64,
