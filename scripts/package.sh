@@ -47,6 +47,17 @@ if [ "$publishable" != "$expected" ]; then
     exit 1
 fi
 
+# Cargo unpacks the overlay registry's crates into
+# $CARGO_HOME/registry/src/<hash of the registry's path>/<crate>-<version> and
+# never again while that directory exists: a second run from the same
+# checkout path verified against the first run's sources (measured: a field
+# added to eigenmpc was missing when eigenmpc-fmu-models was verified). Drop
+# those copies of the workspace's own crates first.
+version=$(sed -n 's/^version = "\(.*\)"/\1/p' Cargo.toml | head -n 1)
+for c in "${crates[@]}"; do
+    rm -rf "${CARGO_HOME:-$HOME/.cargo}"/registry/src/*/"$c-$version"
+done
+
 echo "== [${SECONDS} s] cargo package ${crates[*]} (each verified from its .crate)"
 args=()
 for c in "${crates[@]}"; do args+=(-p "$c"); done
