@@ -382,6 +382,65 @@ pub fn energy_feature_derivatives<const N: usize, const NP: usize>(
     (dq, dqd)
 }
 
+/// The dynamics' regressor `Y(q, qd, qdd)` (`N x NP`): `Y theta` is the
+/// torque `M(q) qdd + C(q, qd) qd + dV/dq + tau_f(qd)` that the chain of
+/// base parameters `theta` needs for the acceleration `qdd`. It is
+/// Lagrange's equation applied to each energy feature
+/// ([`energy_features`]): `d/dt (d phi/d qd) - d phi/d q` for a kinetic
+/// one, `d phi/d q` for a potential one, and each friction feature's torque
+/// (`qd_j`, `atan(k qd_j)`). Every feature's speed derivative is linear in
+/// the speeds, so its rate along the motion is exact in closed form.
+pub fn dynamic_regressor<const N: usize, const NP: usize>(
+    params: &PlanarChainParams<N>,
+    q: &Vector<N>,
+    qd: &Vector<N>,
+    qdd: &Vector<N>,
+) -> SMatrix<f64, N, NP> {
+    type B<const N: usize, const NP: usize> = BaseParameters<N, NP>;
+    let (dq, _) = energy_feature_derivatives::<N, NP>(params, q, qd);
+    let (phi_abs, w) = absolute_angles_and_speeds(q, qd);
+    // Each link's absolute acceleration.
+    let (_, wd) = absolute_angles_and_speeds(q, qdd);
+    let mut y = SMatrix::<f64, N, NP>::zeros();
+    for j in 0..N {
+        // A_jj: d phi/d qd_k = w_j for k <= j, no angle dependence.
+        let jj = B::<N, NP>::a_index(j, j);
+        for k in 0..=j {
+            y[(k, jj)] = wd[j];
+        }
+        for l in j + 1..N {
+            let i = B::<N, NP>::a_index(j, l);
+            let (s, c) = (
+                math::sin(phi_abs[j] - phi_abs[l]),
+                math::cos(phi_abs[j] - phi_abs[l]),
+            );
+            let relative = w[j] - w[l];
+            for k in 0..=l {
+                let in_j = if k <= j { 1.0 } else { 0.0 };
+                // d/dt of d phi/d qd_k = c (w_l [k <= j] + w_j)
+                let rate = -s * relative * (w[l] * in_j + w[j]) + c * (wd[l] * in_j + wd[j]);
+                y[(k, i)] = rate - dq[(i, k)];
+            }
+        }
+        let g = B::<N, NP>::g_index(j);
+        for k in 0..=j {
+            y[(k, g)] = dq[(g, k)];
+        }
+        // The rotor's speed (before - gear qd_j) has no angle dependence.
+        let gear = params.joints[j].gear_ratio;
+        let before: f64 = qdd.iter().take(j).sum();
+        let rotor_rate = before - gear * qdd[j];
+        let r = B::<N, NP>::rotor_index(j);
+        for k in 0..j {
+            y[(k, r)] = rotor_rate;
+        }
+        y[(j, r)] = -gear * rotor_rate;
+        y[(j, B::<N, NP>::viscous_index(j))] = qd[j];
+        y[(j, B::<N, NP>::coulomb_index(j))] = libm::atan(params.coulomb_sharpness * qd[j]);
+    }
+    y
+}
+
 /// The friction power features `phi_F(qd)`: friction power `= theta'
 /// phi_F` (energy entries 0).
 pub fn friction_features<const N: usize, const NP: usize>(

@@ -83,3 +83,4 @@ pub mod mpc;
 pub mod qp;
 #[cfg(feature = "tooling")]
 pub mod robustness;
+pub mod state_parameter_ekf;

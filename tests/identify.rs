@@ -7,8 +7,8 @@
 mod rough_model;
 use eigenmpc::identify::{
     BaseParameters, EnergyBalanceRls, IdentifyError, RESIDUAL_DOF, RlsOptions, WindowEquation,
-    base_parameter_count, energy_feature_derivatives, energy_feature_noise, energy_features,
-    friction_features,
+    base_parameter_count, dynamic_regressor, energy_feature_derivatives, energy_feature_noise,
+    energy_features, friction_features,
 };
 use eigenmpc::integrate::{Dopri5, Tolerances};
 use eigenmpc::math;
@@ -19,7 +19,7 @@ use eigenmpc::model_file::RobotFile;
 use eigenmpc::mpc::Variant;
 use eigenmpc::mpc::closed_loop::{GaussianNoise, robot_controller, run};
 use nalgebra::SVector;
-use rough_model::rough;
+use rough_model::{probing_torque, rough};
 
 fn robot_a0() -> PlanarChainParams<2> {
     let path = concat!(
@@ -126,6 +126,33 @@ fn the_feature_derivatives_match_finite_differences() {
     check_feature_derivatives::<2, 11>(&PlanarChainParams::default());
     check_feature_derivatives::<2, 11>(&robot_a0());
     check_feature_derivatives::<3, 18>(&three_link());
+}
+
+fn check_regressor<const N: usize, const NP: usize>(p: &PlanarChainParams<N>) {
+    let chain = PlanarChain::new(*p).unwrap();
+    let theta = BaseParameters::<N, NP>::of(p).unwrap().theta;
+    for (i, (q, qd)) in states::<N>().into_iter().enumerate() {
+        let qdd = Vector::<N>::from_fn(|j, _| math::sin(2.1 * i as f64 + 0.5 * j as f64) * 20.0);
+        let torque = chain.mass_matrix(&q) * qdd
+            + chain.coriolis_forces(&q, &qd)
+            + chain.potential_gradient(&q)
+            + chain.friction(&qd);
+        let linear = dynamic_regressor::<N, NP>(p, &q, &qd, &qdd) * theta;
+        assert!(
+            (torque - linear).amax() < 1e-12 * (1.0 + torque.amax()),
+            "tau {torque} vs {linear}"
+        );
+    }
+}
+
+/// The dynamics' regressor gives the chain's own inverse dynamics
+/// (inertia, Coriolis, gravity, rotors and friction) at any state and
+/// acceleration.
+#[test]
+fn the_dynamic_regressor_is_the_inverse_dynamics() {
+    check_regressor::<2, 11>(&PlanarChainParams::default());
+    check_regressor::<2, 11>(&robot_a0());
+    check_regressor::<3, 18>(&three_link());
 }
 
 #[test]
@@ -333,11 +360,7 @@ fn identify_a0_noisy(
             &tau,
             dt,
         ));
-        let t = k as f64 * dt;
-        tau = Vector::<2>::new(
-            0.3 * math::sin(2.3 * t) + 0.1 * math::cos(7.1 * t),
-            0.2 * math::sin(3.7 * t),
-        );
+        tau = probing_torque(k as f64 * dt);
         ode.advance_to(
             |_, z| state_derivative::<_, 2, 4>(&system, z, &tau),
             (k + 1) as f64 * dt,
