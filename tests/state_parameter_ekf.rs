@@ -15,12 +15,13 @@ use eigenmpc::state_parameter_ekf::{StateParameterEkf, StateParameterOptions};
 use nalgebra::SVector;
 use rough_model::{probing_torque, rough};
 
-fn robot_a0() -> PlanarChainParams<2> {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/robots/lab-double-pendulum-A0.yml"
-    );
+fn robot(name: &str) -> PlanarChainParams<2> {
+    let path = format!("{}/robots/{name}.yml", env!("CARGO_MANIFEST_DIR"));
     RobotFile::load(path).unwrap().params::<2>().unwrap()
+}
+
+fn robot_a0() -> PlanarChainParams<2> {
+    robot("lab-double-pendulum-A0")
 }
 
 /// The relative errors of the energy parameters (A, G, rotor) against the
@@ -51,6 +52,29 @@ fn identify(
     seed: u64,
 ) -> (SVector<f64, 11>, SVector<f64, 11>, usize) {
     let plant = robot_a0();
+    let energy = closed_loop.then_some(2.0);
+    let (ekf, rls) = identify_with(
+        &plant,
+        &rough(&plant),
+        energy,
+        (angle_noise, speed_noise),
+        seconds,
+        seed,
+    );
+    (ekf.parameters().theta, rls.estimate().theta, ekf.restarts())
+}
+
+/// [`identify`] of `plant` from the model `prior`, in closed loop at
+/// `energy` (J) when given; returns the filter and the energy balance.
+fn identify_with(
+    plant: &PlanarChainParams<2>,
+    prior: &PlanarChainParams<2>,
+    energy: Option<f64>,
+    (angle_noise, speed_noise): (f64, f64),
+    seconds: f64,
+    seed: u64,
+) -> (StateParameterEkf<2, 4, 11, 15>, EnergyBalanceRls<2, 11>) {
+    let plant = *plant;
     let system = PlanarChain::new(plant).unwrap();
     let dt = 0.025;
     let options = StateParameterOptions {
@@ -58,9 +82,9 @@ fn identify(
         speed_noise,
         ..StateParameterOptions::default()
     };
-    let mut ekf = StateParameterEkf::<2, 4, 11, 15>::new(&rough(&plant), options, dt).unwrap();
+    let mut ekf = StateParameterEkf::<2, 4, 11, 15>::new(prior, options, dt).unwrap();
     let mut rls = EnergyBalanceRls::<2, 11>::new(
-        &rough(&plant),
+        prior,
         RlsOptions {
             angle_noise,
             speed_noise,
@@ -74,9 +98,9 @@ fn identify(
         atol: 1e-10,
     };
     let mut ode = Dopri5::new(0.0, SVector::<f64, 4>::new(0.05, 0.05, 0.0, 0.0), tol);
-    let mut controller = closed_loop.then(|| {
-        let model = PlanarChain::new(rough(&plant)).unwrap();
-        robot_controller::<2, 4>(&model, Variant::Curved, 2.0, 0.5)
+    let mut controller = energy.map(|energy| {
+        let model = PlanarChain::new(*prior).unwrap();
+        robot_controller::<2, 4>(&model, Variant::Curved, energy, 0.5)
             .unwrap()
             .0
     });
@@ -100,7 +124,7 @@ fn identify(
         )
         .unwrap();
     }
-    (ekf.parameters().theta, rls.estimate().theta, ekf.restarts())
+    (ekf, rls)
 }
 
 /// Runs [`identify`] at the lab's noise and at twice it, two seeds each;
@@ -115,6 +139,8 @@ fn check(closed_loop: bool, seconds: f64, tolerance: f64) {
             .collect::<Vec<_>>()
             .join(" ")
     };
+    let worst = |e: &[f64]| e[..5].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let mut runs = vec![];
     for (a, s) in [(0.005, 0.05), (0.01, 0.1)] {
         for seed in 1..=2 {
             let (ekf, rls, restarts) = identify(closed_loop, a, s, seconds, seed);
@@ -129,32 +155,34 @@ fn check(closed_loop: bool, seconds: f64, tolerance: f64) {
                 truth[10],
                 percent(&balance)
             );
-            assert_eq!(restarts, 0);
-            let worst = |e: &[f64]| e[..5].iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            assert!(worst(&filter) < tolerance, "{}", percent(&filter));
-            assert!(worst(&filter) < worst(&balance));
-            for i in [9, 10] {
-                assert!((ekf[i] / truth[i] - 1.0).abs() < 0.03, "cf {}", ekf[i]);
-            }
+            runs.push((ekf, filter, balance, restarts));
+        }
+    }
+    for (ekf, filter, balance, restarts) in runs {
+        assert_eq!(restarts, 0);
+        assert!(worst(&filter) < tolerance, "{}", percent(&filter));
+        assert!(worst(&filter) < worst(&balance));
+        for i in [9, 10] {
+            assert!((ekf[i] / truth[i] - 1.0).abs() < 0.03, "cf {}", ekf[i]);
         }
     }
 }
 
-/// Open loop (a sum of sines), 60 s: the link parameters within 4 %
-/// (measured: at most 1.4 % at the lab's noise, 3.9 % at twice it; the
+/// Open loop (a sum of sines), 60 s: the link parameters within 3 %
+/// (measured: at most 1.8 % at the lab's noise, 2.0 % at twice it; the
 /// energy balance's worst per run 12-26 %).
 #[test]
 fn the_filter_finds_the_plants_parameters_under_noise_in_open_loop() {
-    check(false, 60.0, 0.04);
+    check(false, 60.0, 0.03);
 }
 
 /// Closed loop (the rough model's EigenMPC answers the noise), 120 s: the
-/// link parameters within 5 % (measured: at most 4.9 %, one seed at the
-/// lab's noise; 1.5 % in the other three runs; the energy balance's worst
-/// per run 4.6-26 %).
+/// link parameters within 6 % (measured: at most 5.3 %, `A_12`, one seed
+/// at the lab's noise; 1.7 % in the other three runs; the energy balance's
+/// worst per run 4.6-26 %).
 #[test]
 fn the_filter_finds_the_plants_parameters_under_noise_in_closed_loop() {
-    check(true, 120.0, 0.05);
+    check(true, 120.0, 0.06);
 }
 
 /// Bad settings are refused with their name; a non-finite measurement or
@@ -204,4 +232,41 @@ fn bad_input_is_refused_or_skipped() {
     assert!(!ekf.step(&z, &Vector::<2>::new(f64::INFINITY, 0.0)));
     assert_eq!((ekf.state(), ekf.parameters()), before);
     assert_eq!(ekf.restarts(), 0);
+}
+
+/// The lab pendulum B0 from its own model (friction known), in closed loop
+/// at 1.5 J under the lab's noise: its second joint starts held by Coulomb
+/// friction, which the smooth friction model cannot predict. Counted as
+/// process noise near rest, this keeps the link parameters within 4 % and
+/// five of their standard deviations after 30 s (measured: 3.2 % and 4.1
+/// sd on one seed, 1.3 % and 0.9 sd on the other; without it 7.1 % and
+/// 7.7 sd, and on the adaptation's rough-model loop the first half second
+/// moved them 10-20 %). The filter is not yet consistent in closed loop:
+/// its linearisation leaves up to 4 sd.
+#[test]
+fn a_joint_held_by_friction_does_not_move_the_parameters() {
+    let b0 = robot("lab-double-pendulum-B0");
+    let truth = BaseParameters::<2, 11>::of(&b0).unwrap().theta;
+    for seed in 1..=2 {
+        let (ekf, _) = identify_with(&b0, &b0, Some(1.5), (0.005, 0.05), 30.0, seed);
+        let theta = ekf.parameters().theta;
+        let covariance = ekf.parameter_covariance();
+        for i in 0..5 {
+            let (error, sd) = (theta[i] - truth[i], covariance[(i, i)].sqrt());
+            eprintln!(
+                "B0 seed {seed}: theta[{i}] off by {:+.2} % ({:+.1} sd), consistency {:.2} cf {:.4} {:.4}",
+                100.0 * error / truth[i],
+                error / sd,
+                ekf.consistency(),
+                theta[9],
+                theta[10]
+            );
+        }
+        for i in 0..5 {
+            let (error, sd) = (theta[i] - truth[i], covariance[(i, i)].sqrt());
+            assert!(error.abs() < 5.0 * sd && error.abs() < 0.04 * truth[i]);
+        }
+        // The innovations are as large as the filter expects (measured 0.95).
+        assert!((0.8..1.25).contains(&ekf.consistency()));
+    }
 }
