@@ -365,6 +365,9 @@ pub struct Adaptation<const N: usize, const NX: usize, const NP: usize> {
     status: AdaptationStatus,
     shared: Arc<(Mutex<Slot<N>>, Condvar)>,
     worker: Option<JoinHandle<()>>,
+    /// The state and parameters estimated together: when set, candidates
+    /// come from its estimate instead of the energy balance's.
+    filter: Option<Box<dyn crate::state_parameter_ekf::ParameterFilter<N, NX, NP>>>,
 }
 
 impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
@@ -417,7 +420,25 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
             status: AdaptationStatus::Idle,
             shared,
             worker: Some(worker),
+            filter: None,
         })
+    }
+
+    /// Candidates from now on come from `filter`, the state and parameters
+    /// estimated together (fed every sample with the measured state and the
+    /// torque felt; library only, the FMU does not use it yet). Its
+    /// estimate and covariance replace the energy balance's in the
+    /// significance test; its energy scale is taken as known (the
+    /// dynamics give it); and a candidate is taken once the held-out
+    /// windows do not show it worse (the energy balance's windows under
+    /// noise seldom tell a right candidate from the model in use: the
+    /// paper's pendulum refused them all). The supervisor still watches
+    /// each new model. [`Adaptation::save_state`] does not cover the filter.
+    pub fn set_filter(
+        &mut self,
+        filter: Box<dyn crate::state_parameter_ekf::ParameterFilter<N, NX, NP>>,
+    ) {
+        self.filter = Some(filter);
     }
 
     /// The identification.
@@ -500,6 +521,10 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
         dt: f64,
     ) {
         let window = self.rls.add_sample(q, qd, felt, dt);
+        if let Some(filter) = self.filter.as_mut() {
+            let z = SVector::<f64, NX>::from_fn(|i, _| if i < N { q[i] } else { qd[i - N] });
+            filter.step(&z, felt);
+        }
         self.samples += 1;
         let stalls = controller.supervisor_events();
         if stalls > self.stalls_seen {
@@ -684,7 +709,10 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
         // The change is measured on the estimate as a model would take it
         // (rotor inertias and friction not negative): a frictionless joint's
         // estimate scattering below zero is no change.
-        let estimate = self.rls.estimate().projected(&self.prior).theta;
+        let estimate = match &self.filter {
+            Some(filter) => filter.parameters().projected(&self.prior).theta,
+            None => self.rls.estimate().projected(&self.prior).theta,
+        };
         let floor = self.options.rls.prior_floor;
         let relative = |a: &SVector<f64, NP>, b: &SVector<f64, NP>| {
             (0..NP)
@@ -720,9 +748,11 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
         // the 99 % quantile of chi^2 with NP degrees of freedom), not only
         // by the noise of its windows.
         let moved = estimate - self.in_use;
-        let significant = self
-            .rls
-            .covariance()
+        let covariance = match &self.filter {
+            Some(filter) => filter.parameter_covariance(),
+            None => *self.rls.covariance(),
+        };
+        let significant = covariance
             .cholesky()
             .map(|c| moved.dot(&c.solve(&moved)))
             .is_some_and(|d2| d2 > chi2_99(NP));
@@ -752,7 +782,9 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
         // energy the loop settles at, which no measurement shows (measured:
         // a rough model of the lab pendulum A0 ended 7 % high with them,
         // 4 % low without).
-        if self.rls.scale_uncertainty() > self.options.max_scale_uncertainty {
+        if self.filter.is_none()
+            && self.rls.scale_uncertainty() > self.options.max_scale_uncertainty
+        {
             let scale = self.orbit_scale(&estimate, step);
             for i in 0..NP - 2 * N {
                 theta[i] = self.in_use[i] * scale;
@@ -820,11 +852,12 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
         let margin = (6.0 * candidate.distinct.sqrt()).max(0.25 * candidate.distinct);
         // The two must also differ by three standard deviations on those
         // windows: a candidate the windows cannot tell apart is not taken.
+        let worse = candidate.windows >= o.min_validation_windows && candidate.score < -margin;
         let better = candidate.forced
             || (candidate.windows >= o.min_validation_windows
                 && candidate.distinct >= 9.0
-                && candidate.score > margin);
-        let worse = candidate.windows >= o.min_validation_windows && candidate.score < -margin;
+                && candidate.score > margin)
+            || (self.filter.is_some() && candidate.windows >= o.min_validation_windows && !worse);
         if !better && !worse && candidate.windows < o.max_validation_windows {
             self.phase = Phase::Validating(candidate);
             return;

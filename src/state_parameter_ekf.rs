@@ -384,3 +384,34 @@ impl<const N: usize, const NX: usize, const NP: usize, const NA: usize>
         self.covariance = self.initial_covariance;
     }
 }
+
+/// A filter of the state and the base parameters, as the adaptation uses
+/// one (its joint count `N`, state size `NX`, base parameter count `NP`):
+/// the augmented size stays inside.
+pub trait ParameterFilter<const N: usize, const NX: usize, const NP: usize>:
+    Send + std::fmt::Debug
+{
+    /// One sample: the torque that acted since the previous one, then the
+    /// measured state.
+    fn step(&mut self, z: &SVector<f64, NX>, tau: &Vector<N>) -> bool;
+    /// The estimated base parameters.
+    fn parameters(&self) -> BaseParameters<N, NP>;
+    /// Their covariance.
+    fn parameter_covariance(&self) -> SMatrix<f64, NP, NP>;
+}
+
+impl<const N: usize, const NX: usize, const NP: usize, const NA: usize> ParameterFilter<N, NX, NP>
+    for StateParameterEkf<N, NX, NP, NA>
+{
+    fn step(&mut self, z: &SVector<f64, NX>, tau: &Vector<N>) -> bool {
+        StateParameterEkf::step(self, z, tau)
+    }
+
+    fn parameters(&self) -> BaseParameters<N, NP> {
+        StateParameterEkf::parameters(self)
+    }
+
+    fn parameter_covariance(&self) -> SMatrix<f64, NP, NP> {
+        StateParameterEkf::parameter_covariance(self)
+    }
+}
