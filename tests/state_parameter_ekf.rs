@@ -11,7 +11,7 @@ use eigenmpc::integrate::{Dopri5, Tolerances};
 use eigenmpc::mechanics::{PlanarChain, PlanarChainParams, Vector, state_derivative};
 use eigenmpc::model_file::RobotFile;
 use eigenmpc::modes::{ChartFamily, FamilyOptions};
-use eigenmpc::mpc::closed_loop::{GaussianNoise, energy_tail, robot_controller};
+use eigenmpc::mpc::closed_loop::{GaussianNoise, energy_tail, robot_controller, summarise};
 use eigenmpc::mpc::{Controller, EstimatorConfig, MpcConfig, Variant, prediction_substeps};
 use eigenmpc::robustness::{Imperfections, run_imperfect};
 use eigenmpc::state_parameter_ekf::{StateParameterEkf, StateParameterOptions};
@@ -339,23 +339,16 @@ fn the_filter_brings_a_roughly_modelled_pendulum_under_noise_to_its_mode() {
         )
         .unwrap();
         let (energy, _) = energy_tail(&out.samples, e_ref, 5.0);
-        let tail: Vec<_> = out
-            .samples
-            .iter()
-            .filter(|s| s.time > seconds - 5.0 + 1e-9)
-            .collect();
-        let rms = |j: usize| {
-            (tail.iter().map(|s| s.tau[j].powi(2)).sum::<f64>() / tail.len() as f64).sqrt()
-        };
+        let torque = summarise(&out.samples, e_ref, None, 5.0).rms_torque;
         let error = (energy - e_ref) / e_ref;
         eprintln!(
             "filter {filtered}: {:+.2} %, tau {:.3} / {:.3} N m, {} models",
             100.0 * error,
-            rms(0),
-            rms(1),
+            torque[0],
+            torque[1],
             adaptation.model_updates()
         );
-        (error, rms(0).max(rms(1)))
+        (error, torque.max())
     };
     let (error, torque) = run(true);
     assert!(error.abs() < 0.01 && torque <= 0.1, "{error} {torque}");
