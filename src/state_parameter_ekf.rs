@@ -22,6 +22,7 @@ use crate::identify::{
     BaseParameters, IdentifyError, dynamic_regressor, energy_feature_derivatives,
 };
 use crate::mechanics::{PlanarChainParams, Vector};
+use crate::mpc::held_acceleration_noise;
 use nalgebra::{SMatrix, SVector};
 
 /// Share of a new sample in the mean of the normalised innovations squared
@@ -141,19 +142,14 @@ impl<const N: usize, const NX: usize, const NP: usize, const NA: usize>
         let theta = BaseParameters::<N, NP>::of(prior)?.theta;
         let mut estimate = SVector::<f64, NA>::zeros();
         let mut measurement = SMatrix::<f64, NX, NX>::zeros();
-        let mut process = SMatrix::<f64, NA, NA>::zeros();
+        let acceleration = SMatrix::<f64, N, N>::identity() * options.acceleration_noise.powi(2);
+        let mut process = held_acceleration_noise::<N, NA>(&acceleration, dt);
         let mut initial_covariance = SMatrix::<f64, NA, NA>::zeros();
-        let a2 = options.acceleration_noise.powi(2);
         for j in 0..N {
             measurement[(j, j)] = options.angle_noise.powi(2);
             measurement[(N + j, N + j)] = options.speed_noise.powi(2);
             initial_covariance[(j, j)] = measurement[(j, j)];
             initial_covariance[(N + j, N + j)] = measurement[(N + j, N + j)];
-            // A constant acceleration a over dt moves q by a dt^2/2 and qd by a dt.
-            process[(j, j)] = a2 * dt.powi(4) / 4.0;
-            process[(j, N + j)] = a2 * dt.powi(3) / 2.0;
-            process[(N + j, j)] = process[(j, N + j)];
-            process[(N + j, N + j)] = a2 * dt * dt;
         }
         for i in 0..NP {
             estimate[NX + i] = theta[i];
@@ -237,11 +233,10 @@ impl<const N: usize, const NX: usize, const NP: usize, const NA: usize>
     /// held by friction at the start moved the parameters 10-20 % within
     /// half a second (the lab pendulum B0, from its exact model).
     fn sticking_noise(&self) -> SMatrix<f64, NA, NA> {
-        let mut noise = SMatrix::<f64, NA, NA>::zeros();
         let q = Vector::<N>::from_fn(|j, _| self.estimate[j]);
         let theta: SVector<f64, NP> = self.estimate.fixed_rows::<NP>(NX).into_owned();
         let Some(chol) = self.mass_matrix(&q, &theta).cholesky() else {
-            return noise;
+            return SMatrix::zeros();
         };
         let mut torque = SMatrix::<f64, N, N>::zeros();
         for j in 0..N {
@@ -255,18 +250,7 @@ impl<const N: usize, const NX: usize, const NP: usize, const NA: usize>
         }
         // The acceleration's covariance M^-1 D M^-1, held over the sample.
         let inverse = chol.inverse();
-        let acceleration = inverse * torque * inverse;
-        let dt = self.dt;
-        for j in 0..N {
-            for l in 0..N {
-                let a = acceleration[(j, l)];
-                noise[(j, l)] = a * dt.powi(4) / 4.0;
-                noise[(j, N + l)] = a * dt.powi(3) / 2.0;
-                noise[(N + j, l)] = a * dt.powi(3) / 2.0;
-                noise[(N + j, N + l)] = a * dt * dt;
-            }
-        }
-        noise
+        held_acceleration_noise::<N, NA>(&(inverse * torque * inverse), self.dt)
     }
 
     /// The acceleration of the chain of base parameters `theta` at `(q,

@@ -44,6 +44,27 @@ impl EstimatorConfig {
     }
 }
 
+/// The process noise of an acceleration with covariance `acceleration`
+/// (rad^2/s^4, `N x N`) held constant over a sample of `dt` s, on the
+/// leading `(q, qd)` block of an `M`-dimensional state (the rest zero): a
+/// constant acceleration a over dt moves q by a dt^2/2 and qd by a dt.
+pub(crate) fn held_acceleration_noise<const N: usize, const M: usize>(
+    acceleration: &SMatrix<f64, N, N>,
+    dt: f64,
+) -> SMatrix<f64, M, M> {
+    let mut noise = SMatrix::<f64, M, M>::zeros();
+    for j in 0..N {
+        for l in 0..N {
+            let a = acceleration[(j, l)];
+            noise[(j, l)] = a * dt.powi(4) / 4.0;
+            noise[(j, N + l)] = a * dt.powi(3) / 2.0;
+            noise[(N + j, l)] = a * dt.powi(3) / 2.0;
+            noise[(N + j, N + l)] = a * dt * dt;
+        }
+    }
+    noise
+}
+
 /// The extended Kalman filter of a controller (`NX = 2 N`).
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct Ekf<const N: usize, const NX: usize> {
@@ -60,15 +81,10 @@ pub(super) struct Ekf<const N: usize, const NX: usize> {
 impl<const N: usize, const NX: usize> Ekf<N, NX> {
     /// A filter for sample period `dt`.
     pub(super) fn new(config: &EstimatorConfig, dt: f64) -> Self {
-        let mut process = SMatrix::<f64, NX, NX>::zeros();
+        let acceleration = SMatrix::<f64, N, N>::identity() * config.acceleration_noise.powi(2);
+        let process = held_acceleration_noise::<N, NX>(&acceleration, dt);
         let mut measurement = SMatrix::<f64, NX, NX>::zeros();
-        let a2 = config.acceleration_noise.powi(2);
         for j in 0..N {
-            // A constant acceleration a over dt moves q by a dt^2/2 and qd by a dt.
-            process[(j, j)] = a2 * dt.powi(4) / 4.0;
-            process[(j, N + j)] = a2 * dt.powi(3) / 2.0;
-            process[(N + j, j)] = process[(j, N + j)];
-            process[(N + j, N + j)] = a2 * dt * dt;
             measurement[(j, j)] = config.angle_noise.powi(2);
             measurement[(N + j, N + j)] = config.speed_noise.powi(2);
         }

@@ -43,6 +43,7 @@ pub use cost::{
     Variant, VariantInfo, Weights,
 };
 pub use estimator::EstimatorConfig;
+pub(crate) use estimator::held_acceleration_noise;
 pub use prediction::{
     FrictionSmoothing, PREDICTION_SUBSTEPS, prediction_coulomb_sharpness, prediction_model,
     prediction_substeps,
