@@ -99,6 +99,10 @@ impl<const N: usize, const NP: usize> BaseParameters<N, NP> {
         N * (N + 1) / 2 + N + j
     }
 
+    /// Index of the first parameter that is never negative: the rotor
+    /// inertias and the friction coefficients follow.
+    pub(crate) const NOT_NEGATIVE_FROM: usize = Self::rotor_index(0);
+
     const fn viscous_index(j: usize) -> usize {
         N * (N + 1) / 2 + 2 * N + j
     }

@@ -110,6 +110,8 @@ pub struct Controller<S, const N: usize, const NX: usize> {
     embedded: Option<SVector<f64, NX>>,
     /// The stall supervisor ([`supervisor`]).
     supervisor: supervisor::Supervisor<N>,
+    /// Torque added to every solved command ([`Controller::set_excitation`]).
+    excitation: Vector<N>,
 }
 
 /// QP failures in a row after which the plan is discarded and the next
@@ -180,6 +182,7 @@ where
             )),
             embedded: None,
             supervisor: supervisor::Supervisor::new(),
+            excitation: Vector::zeros(),
         })
     }
 
@@ -445,6 +448,22 @@ where
         }
     }
 
+    /// Adds `torque` (N m) to every solved command from the next one on
+    /// (clipped to `tau_max`), as the motor applies it: the estimator,
+    /// the delay compensation and [`Controller::torque_before_measurement`]
+    /// know it. The adaptation's excitation: a torque the loop does not
+    /// make from its own state, so that the identification can tell the
+    /// model's scale from its friction (under feedback alone the torque is
+    /// a function of the state).
+    pub fn set_excitation(&mut self, torque: &Vector<N>) {
+        self.excitation = torque.map(|v| if v.is_finite() { v } else { 0.0 });
+    }
+
+    /// The torque added to every solved command (N m).
+    pub fn excitation(&self) -> &Vector<N> {
+        &self.excitation
+    }
+
     /// One control step: preparation (unless already done) and feedback.
     pub fn step(&mut self, z: &SVector<f64, NX>) -> ControlOutput<N> {
         self.prepare();
@@ -553,6 +572,9 @@ where
         }
         if measured && !releasing {
             self.supervise(&raw, &mut out);
+        }
+        if out.status.is_ok() && self.excitation.iter().any(|v| *v != 0.0) {
+            out.tau = self.clip(&(out.tau + self.excitation));
         }
         // The plan's first control is the torque to apply; with a declared
         // motor response the command is the one that makes the motor apply

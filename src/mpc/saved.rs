@@ -35,6 +35,8 @@ pub struct ControllerState<S, const N: usize, const NX: usize> {
     history: CommandHistory<N>,
     embedded: Option<SVector<f64, NX>>,
     supervisor: Supervisor<N>,
+    /// The torque added to the commands ([`Controller::set_excitation`]).
+    excitation: Vector<N>,
     /// The QP solver's warm start ([`crate::qp::QpSolver::save_warm_start`]).
     solver: Vec<f64>,
 }
@@ -63,6 +65,7 @@ where
             history: self.history.clone(),
             embedded: self.embedded,
             supervisor: self.supervisor.clone(),
+            excitation: self.excitation,
             solver: self.solver.save_warm_start(),
         }
     }
@@ -102,6 +105,7 @@ where
         }
         let finite = state.merit_penalty.is_finite()
             && state.history.is_finite()
+            && state.excitation.iter().all(|v| v.is_finite())
             && state
                 .embedded
                 .is_none_or(|x| x.iter().all(|v| v.is_finite()))
@@ -140,6 +144,7 @@ where
         self.history = state.history;
         self.embedded = state.embedded;
         self.supervisor = state.supervisor;
+        self.excitation = state.excitation;
         // The QP is rebuilt from the plan (deterministic: the same numbers).
         self.prepared = false;
         self.pending_preparation_time = 0.0;
