@@ -172,7 +172,7 @@ fn check(closed_loop: bool, seconds: f64, tolerance: f64) {
 }
 
 /// Open loop (a sum of sines), 60 s: the link parameters within 3 %
-/// (measured: at most 1.8 % at the lab's noise, 2.0 % at twice it; the
+/// (measured: at most 1.8 % at the lab's noise, 1.9 % at twice it; the
 /// energy balance's worst per run 12-26 %).
 #[test]
 fn the_filter_finds_the_plants_parameters_under_noise_in_open_loop() {
@@ -180,7 +180,7 @@ fn the_filter_finds_the_plants_parameters_under_noise_in_open_loop() {
 }
 
 /// Closed loop (the rough model's EigenMPC answers the noise), 120 s: the
-/// link parameters within 6 % (measured: at most 5.3 %, `A_12`, one seed
+/// link parameters within 6 % (measured: at most 5.0 %, `A_12`, one seed
 /// at the lab's noise; 1.7 % in the other three runs; the energy balance's
 /// worst per run 4.6-26 %).
 #[test]
@@ -280,9 +280,10 @@ fn a_joint_held_by_friction_does_not_move_the_parameters() {
 /// report's rough model + noise, where the energy balance's estimate leaves
 /// the orbit forced (0 of 21 in the report). With the filter as the source
 /// of candidates the plant ends within 1 % of E_ref with at most 0.1 N m
-/// of torque (measured: -0.28 %, 0.041 / 0.064 N m, 7 models; -1.0 % at 60
-/// s and -1.1 % at 90 s, still converging); with the energy balance it
-/// does not (+4.1 %, 0.30 / 0.49 N m).
+/// of torque (measured: +0.23 %, 0.030 / 0.032 N m, 2 models, excited
+/// over the first 40 s; -0.28 %, 0.041 / 0.064 N m, 7 models before the
+/// excitation); with the energy balance it does not (+4.1 %, 0.30 / 0.49
+/// N m).
 #[test]
 fn the_filter_brings_a_roughly_modelled_pendulum_under_noise_to_its_mode() {
     let truth = PlanarChainParams::<2>::default();
