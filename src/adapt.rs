@@ -395,7 +395,7 @@ pub struct Adaptation<const N: usize, const NX: usize, const NP: usize> {
     /// come from its estimate instead of the energy balance's.
     filter: Option<Box<dyn crate::state_parameter_ekf::ParameterFilter<N, NX, NP>>>,
     /// The excitation's generator.
-    excitation: crate::mpc::closed_loop::GaussianNoise,
+    excitation: crate::noise::GaussianNoise,
 }
 
 impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
@@ -449,7 +449,7 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
             shared,
             worker: Some(worker),
             filter: None,
-            excitation: crate::mpc::closed_loop::GaussianNoise::new(0x0e1c_17a7_1000),
+            excitation: crate::noise::GaussianNoise::new(0x0e1c_17a7_1000),
         })
     }
 
@@ -464,8 +464,8 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
     /// paper's pendulum refused them all). The supervisor still watches
     /// each new model. Over its first `excitation_time` the commands carry
     /// an excitation torque ([`AdaptOptions::excitation`]).
-    /// [`Adaptation::save_state`] covers neither the filter nor the
-    /// excitation's generator.
+    /// [`Adaptation::save_state`] covers the filter (restored into one set
+    /// the same way).
     pub fn set_filter(
         &mut self,
         filter: Box<dyn crate::state_parameter_ekf::ParameterFilter<N, NX, NP>>,
@@ -1139,6 +1139,10 @@ pub struct AdaptationState<const N: usize, const NP: usize> {
     last_event: Option<(usize, AdaptationEvent)>,
     events: usize,
     status: AdaptationStatus,
+    /// The filter's, when one is set.
+    filter: Option<crate::state_parameter_ekf::FilterState>,
+    /// The excitation generator's state.
+    excitation: u64,
 }
 
 impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
@@ -1177,6 +1181,8 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
             last_event: self.last_event,
             events: self.events,
             status: self.status,
+            filter: self.filter.as_ref().map(|f| f.save_state()),
+            excitation: self.excitation.state(),
         }
     }
 
@@ -1185,6 +1191,20 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
     /// the worker is still computing for the state before are dropped.
     pub fn restore_state(&mut self, state: AdaptationState<N, NP>) -> Result<(), IdentifyError> {
         self.rls.check_compatible(&state.rls)?;
+        match (&mut self.filter, &state.filter) {
+            (Some(filter), Some(saved)) => {
+                // Checked before anything changes; nothing after it fails.
+                filter
+                    .restore_state(saved)
+                    .map_err(IdentifyError::NotPhysical)?;
+            }
+            (None, None) => {}
+            _ => {
+                return Err(IdentifyError::NotPhysical(
+                    "the saved adaptation has another filter set-up".into(),
+                ));
+            }
+        }
         let (lock, wake) = &*self.shared;
         let mut slot = lock.lock().unwrap_or_else(|e| e.into_inner());
         self.generation += 1;
@@ -1212,6 +1232,7 @@ impl<const N: usize, const NX: usize, const NP: usize> Adaptation<N, NX, NP> {
         self.last_event = state.last_event;
         self.events = state.events;
         self.status = state.status;
+        self.excitation = crate::noise::GaussianNoise::new(state.excitation);
         wake.notify_all();
         Ok(())
     }

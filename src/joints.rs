@@ -23,8 +23,9 @@ macro_rules! joint_count_table {
 }
 
 /// Runs `$body` with `N`, `S = 2 N` and `NP = base_parameter_count(N)`
-/// bound as constants for the joint count `$n` (a `usize` known at run
-/// time), or evaluates `$otherwise` when `$n` is not a supported count.
+/// (and, named as a fourth, `NA = S + NP`) bound as constants for the
+/// joint count `$n` (a `usize` known at run time), or evaluates
+/// `$otherwise` when `$n` is not a supported count.
 ///
 /// ```
 /// use eigenmpc::with_joint_count;
@@ -41,7 +42,20 @@ macro_rules! joint_count_table {
 macro_rules! with_joint_count {
     ($n:expr, |$N:ident, $S:ident, $NP:ident| $body:expr, otherwise $otherwise:expr) => {
         $crate::joint_count_table!(__with_joint_count_match!(
-            $n, $N, $S, $NP, $body, $otherwise
+            $n,
+            $N,
+            $S,
+            $NP,
+            __EIGENMPC_AUGMENTED,
+            $body,
+            $otherwise
+        ))
+    };
+    // With `NA = S + NP` too: the size of the state and the parameters
+    // estimated together ([`crate::state_parameter_ekf`]).
+    ($n:expr, |$N:ident, $S:ident, $NP:ident, $NA:ident| $body:expr, otherwise $otherwise:expr) => {
+        $crate::joint_count_table!(__with_joint_count_match!(
+            $n, $N, $S, $NP, $NA, $body, $otherwise
         ))
     };
 }
@@ -49,7 +63,7 @@ macro_rules! with_joint_count {
 #[macro_export]
 #[doc(hidden)]
 macro_rules! __with_joint_count_match {
-    ($n:expr, $N:ident, $S:ident, $NP:ident, $body:expr, $otherwise:expr ; $($k:literal)*) => {
+    ($n:expr, $N:ident, $S:ident, $NP:ident, $NA:ident, $body:expr, $otherwise:expr ; $($k:literal)*) => {
         match $n {
             $(
                 $k => {
@@ -59,6 +73,8 @@ macro_rules! __with_joint_count_match {
                     const $S: usize = 2 * $k;
                     #[allow(dead_code)]
                     const $NP: usize = $crate::identify::base_parameter_count($k);
+                    #[allow(dead_code)]
+                    const $NA: usize = 2 * $k + $crate::identify::base_parameter_count($k);
                     $body
                 }
             )*
@@ -113,6 +129,8 @@ mod tests {
         for &n in JOINT_COUNTS {
             let got = with_joint_count!(n, |N, S, NP| Some(sizes::<N, S, NP>()), otherwise None);
             assert_eq!(got, Some((n, state_size(n), base_parameter_count(n))));
+            let augmented = with_joint_count!(n, |N, S, NP, NA| Some(NA), otherwise None);
+            assert_eq!(augmented, Some(state_size(n) + base_parameter_count(n)));
         }
         assert_eq!(base_parameter_count(2), 11);
         assert_eq!(base_parameter_count(3), 18);

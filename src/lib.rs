@@ -80,6 +80,7 @@ pub mod mechanics;
 pub mod model_file;
 pub mod modes;
 pub mod mpc;
+pub mod noise;
 pub mod qp;
 #[cfg(feature = "tooling")]
 pub mod robustness;

@@ -392,6 +392,61 @@ impl<const N: usize, const NX: usize, const NP: usize, const NA: usize>
     }
 }
 
+/// What a [`StateParameterEkf`] carries from one sample to the next (an
+/// FMU's saved state): its estimate and covariance, flattened.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct FilterState {
+    estimate: Vec<f64>,
+    covariance: Vec<f64>,
+    started: bool,
+    restarts: usize,
+    consistency: f64,
+}
+
+impl<const N: usize, const NX: usize, const NP: usize, const NA: usize>
+    StateParameterEkf<N, NX, NP, NA>
+{
+    /// Everything the next samples depend on. Allocates (not for the
+    /// sample path).
+    pub fn save_state(&self) -> FilterState {
+        FilterState {
+            estimate: self.estimate.iter().copied().collect(),
+            covariance: self.covariance.iter().copied().collect(),
+            started: self.started,
+            restarts: self.restarts,
+            consistency: self.consistency,
+        }
+    }
+
+    /// Continues from `state`, saved by a filter of the same size (the
+    /// prior, noise and sample period are this filter's). Nothing changes
+    /// when it does not fit.
+    pub fn restore_state(&mut self, state: &FilterState) -> Result<(), String> {
+        if state.estimate.len() != NA || state.covariance.len() != NA * NA {
+            return Err(format!(
+                "a filter state of {} values and {} covariances for {NA}",
+                state.estimate.len(),
+                state.covariance.len()
+            ));
+        }
+        let finite = state
+            .estimate
+            .iter()
+            .chain(&state.covariance)
+            .chain([&state.consistency])
+            .all(|v| v.is_finite());
+        if !finite {
+            return Err("a filter state with non-finite values".into());
+        }
+        self.estimate = SVector::<f64, NA>::from_column_slice(&state.estimate);
+        self.covariance = SMatrix::<f64, NA, NA>::from_column_slice(&state.covariance);
+        self.started = state.started;
+        self.restarts = state.restarts;
+        self.consistency = state.consistency;
+        Ok(())
+    }
+}
+
 /// A filter of the state and the base parameters, as the adaptation uses
 /// one (its joint count `N`, state size `NX`, base parameter count `NP`):
 /// the augmented size stays inside.
@@ -405,6 +460,10 @@ pub trait ParameterFilter<const N: usize, const NX: usize, const NP: usize>:
     fn parameters(&self) -> BaseParameters<N, NP>;
     /// Their covariance.
     fn parameter_covariance(&self) -> SMatrix<f64, NP, NP>;
+    /// Everything the next samples depend on (allocates).
+    fn save_state(&self) -> FilterState;
+    /// Continues from `state`; nothing changes when it does not fit.
+    fn restore_state(&mut self, state: &FilterState) -> Result<(), String>;
 }
 
 impl<const N: usize, const NX: usize, const NP: usize, const NA: usize> ParameterFilter<N, NX, NP>
@@ -420,5 +479,13 @@ impl<const N: usize, const NX: usize, const NP: usize, const NA: usize> Paramete
 
     fn parameter_covariance(&self) -> SMatrix<f64, NP, NP> {
         StateParameterEkf::parameter_covariance(self)
+    }
+
+    fn save_state(&self) -> FilterState {
+        StateParameterEkf::save_state(self)
+    }
+
+    fn restore_state(&mut self, state: &FilterState) -> Result<(), String> {
+        StateParameterEkf::restore_state(self, state)
     }
 }

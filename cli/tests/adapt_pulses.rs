@@ -20,8 +20,8 @@ fn torque_pulses_do_not_teach_the_model() {
             unit: "",
             perturbation: Perturbation::TorquePulses(profile),
         };
-        let off = run_case::<2, 4, 11>(&setup, &case, 1, false).unwrap();
-        let on = run_case::<2, 4, 11>(&setup, &case, 1, true).unwrap();
+        let off = run_case::<2, 4, 11, 15>(&setup, &case, 1, false).unwrap();
+        let on = run_case::<2, 4, 11, 15>(&setup, &case, 1, true).unwrap();
         eprintln!(
             "profile {profile}: off {:+.3} %, {:.3?} N m; on {:+.3} %, {:.3?} N m, {} models",
             100.0 * off.energy_error,

@@ -162,8 +162,8 @@ trait JointController: Send {
     fn reset(&mut self);
 }
 
-impl<const N: usize, const NX: usize, const NP: usize> JointController
-    for AdaptiveController<N, NX, NP>
+impl<const N: usize, const NX: usize, const NP: usize, const NA: usize> JointController
+    for AdaptiveController<N, NX, NP, NA>
 {
     fn joints(&self) -> usize {
         N
@@ -432,18 +432,18 @@ pub unsafe extern "C" fn eigenmpc_create(
                 row.copy_from_slice(&coef[j * CHART_COEFFICIENTS..(j + 1) * CHART_COEFFICIENTS]);
             }
         }
-        handle::<2, 4, 11>(&settings)
+        handle::<2, 4, 11, 15>(&settings)
     }));
     // SAFETY: the caller's guarantee on `error`.
     unsafe { finish_create("eigenmpc_create", result, error, error_len) }
 }
 
 /// A handle for the controller `settings` define.
-fn handle<const N: usize, const NX: usize, const NP: usize>(
+fn handle<const N: usize, const NX: usize, const NP: usize, const NA: usize>(
     settings: &Settings<N>,
 ) -> Result<EigenMpc, String> {
     let controller: Box<dyn JointController> =
-        Box::new(AdaptiveController::<N, NX, NP>::new(settings)?);
+        Box::new(AdaptiveController::<N, NX, NP, NA>::new(settings)?);
     Ok(EigenMpc {
         controller,
         variant: settings.variant,
@@ -521,7 +521,7 @@ pub unsafe extern "C" fn eigenmpc_create_named(
         let n = joints as usize;
         eigenmpc::with_joint_count!(
             n,
-            |N, S, NP| handle::<N, S, NP>(&products::settings_from_named::<N>(&pairs)?),
+            |N, S, NP, NA| handle::<N, S, NP, NA>(&products::settings_from_named::<N>(&pairs)?),
             otherwise Err(format!("joints = {n}: {}", eigenmpc::joints::unsupported(n)))
         )
     }));

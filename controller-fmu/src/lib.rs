@@ -17,6 +17,7 @@ pub use eigenmpc_fmu_models::controller::settings::{self, ChainController, Setti
 pub use eigenmpc_fmu_models::controller::start_values::start_values;
 pub use eigenmpc_fmu_models::controller::{ControllerProduct, description};
 pub use eigenmpc_fmu_models::enums::{
+    ADAPT_ESTIMATOR, ADAPT_ESTIMATOR_ENERGY_BALANCE, ADAPT_ESTIMATOR_STATE_AND_PARAMETERS,
     CHART_SOURCE, CHART_SOURCE_COMPUTED, CHART_SOURCE_PARAMETERS, QP_SOLVER, QP_SOLVER_CLARABEL,
     QP_SOLVER_RICCATI, STATE_ESTIMATOR, STATE_ESTIMATOR_EKF, STATE_ESTIMATOR_NONE, VARIANT,
     VARIANT_CURVED, VARIANT_HYBRID, VARIANT_STRAIGHT,

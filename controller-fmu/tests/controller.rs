@@ -1028,8 +1028,10 @@ fn c_api_adapts_and_reports_the_estimate() {
     let mut settings = EigenMpc2::settings(Variant::Curved);
     settings.adapt = true;
     let mut native =
-        eigenmpc_fmu_models::controller::adaptive::AdaptiveController::<2, 4, 11>::new(&settings)
-            .unwrap();
+        eigenmpc_fmu_models::controller::adaptive::AdaptiveController::<2, 4, 11, 15>::new(
+            &settings,
+        )
+        .unwrap();
     // a plant with m2 20 % heavier than the model's: the estimate moves
     let plant = eigenmpc::mechanics::PlanarChain::new(PlanarChainParams::point_masses(
         [1.0, 1.2],

@@ -2,7 +2,7 @@
 //! (name, item, library value, description), used by the FMU variable
 //! tables, the C API and the C header.
 
-use crate::controller::settings::{ChartSource, StateEstimator};
+use crate::controller::settings::{AdaptEstimator, ChartSource, StateEstimator};
 use eigenmpc::adapt::AdaptationStatus;
 use eigenmpc::mpc::{QpBackend, VARIANTS, Variant};
 use fmi2_slave::EnumerationType;
@@ -49,6 +49,23 @@ impl<T: Copy + PartialEq + std::fmt::Debug + 'static> Enumeration<T> {
                     self.parameter,
                     self.type_name,
                     list.join(", ")
+                )
+            })
+    }
+
+    /// The library value of the item called `name`; the message lists the
+    /// names (a command line's `--adapt-estimator state_and_parameters`).
+    pub fn named(&self, name: &str) -> Result<T, String> {
+        self.items
+            .iter()
+            .find(|i| i.name == name)
+            .map(|i| i.value)
+            .ok_or_else(|| {
+                let names: Vec<&str> = self.items.iter().map(|i| i.name).collect();
+                format!(
+                    "{} = {name} is not one of {}",
+                    self.parameter,
+                    names.join(", ")
                 )
             })
     }
@@ -165,6 +182,27 @@ pub const STATE_ESTIMATOR: Enumeration<StateEstimator> = Enumeration {
     ],
 };
 
+/// `adapt_estimator`: where the adaptation's candidate models come from.
+pub const ADAPT_ESTIMATOR: Enumeration<AdaptEstimator> = Enumeration {
+    type_name: "AdaptEstimator",
+    parameter: "adapt_estimator",
+    items: &[
+        Item {
+            name: "energy_balance",
+            item: 1,
+            value: AdaptEstimator::EnergyBalance,
+            description: "The energy balance over windows (recursive least squares)",
+        },
+        Item {
+            name: "state_and_parameters",
+            item: 2,
+            value: AdaptEstimator::StateAndParameters,
+            description: "The state and the base parameters estimated together every sample, \
+                          the loop excited over the first 40 s",
+        },
+    ],
+};
+
 /// `adaptation_status`: what the online adaptation is doing (an output).
 pub const ADAPTATION_STATUS: Enumeration<AdaptationStatus> = Enumeration {
     type_name: "AdaptationStatus",
@@ -224,6 +262,10 @@ pub const QP_SOLVER_RICCATI: i32 = QP_SOLVER.items[1].item;
 pub const STATE_ESTIMATOR_NONE: i32 = STATE_ESTIMATOR.items[0].item;
 /// `state_estimator` item: extended Kalman filter.
 pub const STATE_ESTIMATOR_EKF: i32 = STATE_ESTIMATOR.items[1].item;
+/// `adapt_estimator` item: the energy balance (default).
+pub const ADAPT_ESTIMATOR_ENERGY_BALANCE: i32 = ADAPT_ESTIMATOR.items[0].item;
+/// `adapt_estimator` item: the state and parameters estimated together.
+pub const ADAPT_ESTIMATOR_STATE_AND_PARAMETERS: i32 = ADAPT_ESTIMATOR.items[1].item;
 /// `chart_source` item: computed from the model (default).
 pub const CHART_SOURCE_COMPUTED: i32 = CHART_SOURCE.items[0].item;
 /// `chart_source` item: the chart parameters.
@@ -255,6 +297,27 @@ mod tests {
             assert_eq!(STATE_ESTIMATOR.value(STATE_ESTIMATOR.item(e)), Ok(e));
         }
         assert_eq!((STATE_ESTIMATOR_NONE, STATE_ESTIMATOR_EKF), (1, 2));
+        for e in [
+            AdaptEstimator::EnergyBalance,
+            AdaptEstimator::StateAndParameters,
+        ] {
+            assert_eq!(ADAPT_ESTIMATOR.value(ADAPT_ESTIMATOR.item(e)), Ok(e));
+        }
+        assert_eq!(
+            (
+                ADAPT_ESTIMATOR_ENERGY_BALANCE,
+                ADAPT_ESTIMATOR_STATE_AND_PARAMETERS
+            ),
+            (1, 2)
+        );
+        assert_eq!(
+            ADAPT_ESTIMATOR.named("state_and_parameters"),
+            Ok(AdaptEstimator::StateAndParameters)
+        );
+        assert_eq!(
+            ADAPT_ESTIMATOR.named("ekf"),
+            Err("adapt_estimator = ekf is not one of energy_balance, state_and_parameters".into())
+        );
         for a in [
             AdaptationStatus::Idle,
             AdaptationStatus::Excitation,

@@ -182,11 +182,11 @@ impl Model for ExportedFmu {
         let n = spec.joints;
         let running: Box<dyn Running> = eigenmpc::with_joint_count!(
             n,
-            |N, S, NP| match spec.kind {
+            |N, S, NP, NA| match spec.kind {
                 Kind::Controller => {
                     let defaults = spec.controller_settings::<N>().map_err(ModelError::Error)?;
                     let family = precomputed_family::<N>(ctx);
-                    Box::new(ControllerFmu::<Exported, N, S, NP>::initialize_with(
+                    Box::new(ControllerFmu::<Exported, N, S, NP, NA>::initialize_with(
                         values,
                         ctx,
                         defaults,

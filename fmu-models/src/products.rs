@@ -22,9 +22,9 @@ pub struct DoublePendulumPlant;
 pub struct TriplePendulumPlant;
 
 /// `EigenMPC.fmu`.
-pub type EigenMpcFmu = ControllerFmu<EigenMpc2, 2, 4, 11>;
+pub type EigenMpcFmu = ControllerFmu<EigenMpc2, 2, 4, 11, 15>;
 /// `EigenMPC3.fmu`.
-pub type EigenMpc3Fmu = ControllerFmu<EigenMpc3, 3, 6, 18>;
+pub type EigenMpc3Fmu = ControllerFmu<EigenMpc3, 3, 6, 18, 24>;
 /// `DoublePendulum.fmu`.
 pub type DoublePendulumFmu = PlantFmu<DoublePendulumPlant, 2, 4>;
 /// `TriplePendulum.fmu`.

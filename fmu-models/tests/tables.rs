@@ -118,9 +118,11 @@ fn the_two_joint_controller_keeps_the_original_value_references() {
     assert_eq!(vr(&d, "supervisor_events"), (BaseType::Integer, 12));
     // then the motor's response per sample (issue 37)
     assert_eq!(vr(&d, "torque_response"), (BaseType::Real, 159));
+    // then the adaptation's source (issue 37)
+    assert_eq!(vr(&d, "adapt_estimator"), (BaseType::Integer, 13));
     assert_eq!(
         d.variables.len(),
-        24 + 20 + 5 + 17 + 6 + 4 + 3 + 11 + 1 + 1 + 2 + 3 + 2 + 1
+        24 + 20 + 5 + 17 + 6 + 4 + 3 + 11 + 1 + 1 + 2 + 3 + 2 + 1 + 1
     );
 }
 

@@ -4,7 +4,6 @@
 
 use super::{ControlOutput, ControlStatus, Controller};
 use crate::integrate::{Dopri5, IntegrationError, Tolerances};
-use crate::math;
 use crate::mechanics::{MechanicalSystem, Vector, state_derivative, state_energy};
 use nalgebra::SVector;
 
@@ -234,47 +233,7 @@ where
     )
 }
 
-/// Deterministic Gaussian noise for measured closed loops (xorshift64* and
-/// Box-Muller): the same seed gives the same sequence on every machine.
-#[derive(Clone, Debug)]
-pub struct GaussianNoise(u64);
-
-impl GaussianNoise {
-    /// A generator with `seed` (0 is replaced by a fixed nonzero seed).
-    pub fn new(seed: u64) -> Self {
-        Self(if seed == 0 {
-            0x9e37_79b9_7f4a_7c15
-        } else {
-            seed
-        })
-    }
-
-    /// Uniform in (0, 1).
-    pub fn uniform(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        let x = self.0.wrapping_mul(0x2545_f491_4f6c_dd1d);
-        ((x >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-
-    /// One standard normal sample.
-    pub fn sample(&mut self) -> f64 {
-        let (u, v) = (self.uniform(), self.uniform());
-        (-2.0 * math::ln(u)).sqrt() * math::cos(2.0 * std::f64::consts::PI * v)
-    }
-
-    /// `z` with independent noise of standard deviation `angle` (rad) on
-    /// the angles and `speed` (rad/s) on the speeds.
-    pub fn measure<const NX: usize>(
-        &mut self,
-        z: &SVector<f64, NX>,
-        angle: f64,
-        speed: f64,
-    ) -> SVector<f64, NX> {
-        SVector::from_fn(|i, _| z[i] + if i < NX / 2 { angle } else { speed } * self.sample())
-    }
-}
+pub use crate::noise::GaussianNoise;
 
 /// Summary figures of a run (issue 3 / paper section V).
 #[derive(Clone, Debug, PartialEq)]

@@ -677,3 +677,100 @@ def test_a_lagging_motor_declared_holds_the_mode(controller_md, controller_unzip
     assert np.all(u_on <= 0.03)
     # undeclared, the same loop misses the rule (the test can fail)
     assert abs(e_off - 14.0) > 0.01 * 14.0 or np.any(u_off > 0.03)
+
+
+def report_rough_model(robot, index):
+    """FMU start values of rough model `index` of `robot` as the robustness
+    report makes it (`eigenmpc_cli::robustness::rough_model`): each link's
+    mass, centre-of-mass distance and inertia about its centre of mass times
+    its own factor, uniform in 1 +- 0.2 from the project's seeded generator
+    (xorshift64*, the same numbers as in Rust), no friction."""
+    mask = (1 << 64) - 1
+    state = 0x0AC0_0000_0000 + index
+
+    def uniform():
+        nonlocal state
+        state ^= state >> 12
+        state ^= (state << 25) & mask
+        state ^= state >> 27
+        x = (state * 0x2545_F491_4F6C_DD1D) & mask
+        return ((x >> 11) + 0.5) / float(1 << 53)
+
+    start = fmu_parameters(robot, friction=False)
+    for j in (1, 2):
+        m, r, inertia = start[f"m[{j}]"], start[f"r[{j}]"], start[f"I[{j}]"]
+        about_com = inertia - m * r * r
+        m, r, about_com = (v * (1.0 + 0.2 * (2.0 * uniform() - 1.0)) for v in (m, r, about_com))
+        start[f"m[{j}]"], start[f"r[{j}]"], start[f"I[{j}]"] = m, r, about_com + m * r * r
+    return start
+
+
+def test_report_rough_models_are_the_rust_ones():
+    """The generator above gives the report's numbers: rough model 0 of A0
+    as `eigenmpc_cli::robustness::rough_model` makes it (its first factors,
+    pinned in cli/src/robustness/mod.rs's test)."""
+    robot = robot_file(Path(__file__).resolve().parents[2] / "robots" / "lab-double-pendulum-A0.yml")
+    rough = report_rough_model(robot, 0)
+    for j in (1, 2):
+        assert 0.8 <= rough[f"m[{j}]"] / robot[f"m{j}"] <= 1.2
+        assert rough[f"b[{j}]"] == 0.0 and rough[f"cf[{j}]"] == 0.0
+    assert rough["m[1]"] / robot["m1"] == pytest.approx(0.8379975512711284, rel=1e-14)
+
+
+def lab_rough_runs(controller_md, controller_unzipped, plant_md, plant_unzipped, name, e_ref, estimator):
+    """Issue 37's first criterion for one lab robot: rough models 0-9 of the
+    report under the lab's noise with the EKF, adapt on with `estimator`
+    (1 energy balance, 2 state and parameters), 120 s. Returns per model the
+    energy error (share of E_ref), the RMS torque and the friction torque
+    (N m per joint) over the last 5 s, and the outputs' last values."""
+    robot = robot_file(Path(__file__).resolve().parents[2] / "robots" / f"{name}.yml")
+    b = np.array([robot["b1"], robot["b2"]])
+    cf = np.array([robot["cf1"], robot["cf2"]])
+    runs = []
+    for index in range(10):
+        rng = np.random.default_rng(3700 + index)
+        rows, _, last = co_simulate(
+            controller_md, controller_unzipped, plant_md, plant_unzipped, 120.0,
+            ctrl_start={**report_rough_model(robot, index), **LAB_EKF, "E_ref": e_ref, "tau_max": 0.5,
+                        "adapt": True, "adapt_estimator": estimator},
+            plant_start=fmu_parameters(robot),
+            outputs=["model_updates", "adaptation_status", "supervisor_events"],
+            measure=lambda z: np.asarray(z) + rng.normal(0.0, 1.0, 4) * LAB_NOISE,
+        )
+        tail = rows[rows[:, 0] > 115.0 + 1e-9]
+        qd = tail[:, 3:5]
+        friction = np.sqrt(np.mean((b * qd + cf * np.arctan(100.0 * qd)) ** 2, axis=0))
+        runs.append(((np.mean(tail[:, 7]) - e_ref) / e_ref, rms_torque(rows), friction, last))
+    return runs
+
+
+@pytest.mark.parametrize("name, e_ref", [("lab-double-pendulum-A0", 2.0), ("lab-double-pendulum-B0", 1.5)])
+def test_ten_rough_models_of_a_lab_robot_under_noise_reach_its_mode(
+    controller_md, controller_unzipped, plant_md, plant_unzipped, name, e_ref,
+):
+    """Issue 37's first "done when" under fmpy: the lab robot as the plant
+    FMU, the controller FMU given each of the report's rough models 0-9
+    (masses, centres of mass and inertias up to 20 % off, no friction), the
+    lab's sensor noise (0.005 rad, 0.05 rad/s) and the EKF told it, adapt on
+    with adapt_estimator = state_and_parameters, 120 s: every run ends within
+    2 % of E_ref with an RMS torque per joint at most 1.3 times the friction
+    torque + 0.02 N m. On B0 the energy balance does not."""
+    def met(runs):
+        return [abs(e) <= 0.02 and np.all(tau <= 1.3 * fr + 0.02) for e, tau, fr, _ in runs]
+
+    runs = lab_rough_runs(controller_md, controller_unzipped, plant_md, plant_unzipped, name, e_ref, 2)
+    ok = met(runs)
+    FIGURES.append(
+        f"fmpy, {name} from the report's rough models 0-9, lab noise, EKF, adapt_estimator = "
+        f"state_and_parameters, 120 s: {sum(ok)} of 10 within 2 % and 1.3 friction + 0.02 N m; energy "
+        + ", ".join(f"{100 * e:+.2f} %" for e, _, _, _ in runs)
+        + "; torque over friction "
+        + ", ".join(f"{np.max(tau - fr):+.3f}" for _, tau, fr, _ in runs)
+        + f" N m; models {[r[3]['model_updates'] for r in runs]}"
+    )
+    assert all(ok)
+    assert all(r[3]["adaptation_status"] != 2 for r in runs)  # the excitation is over
+    if name.endswith("B0"):
+        balance = met(lab_rough_runs(controller_md, controller_unzipped, plant_md, plant_unzipped, name, e_ref, 1))
+        FIGURES.append(f"fmpy, {name}, the same with the energy balance: {sum(balance)} of 10")
+        assert sum(balance) <= 8

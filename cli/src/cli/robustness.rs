@@ -48,6 +48,10 @@ pub struct RobustnessArgs {
     /// it is told them, as its filter is told the noise): robustness to them unmodelled.
     #[arg(long)]
     undeclared: bool,
+    /// Where the adaptation's candidate models come from (the controller FMU's
+    /// `adapt_estimator`): `energy_balance` or `state_and_parameters`.
+    #[arg(long, default_value = "energy_balance")]
+    adapt_estimator: String,
     /// Worker threads (default: all local cores); the numbers do not depend on it.
     #[arg(long)]
     threads: Option<usize>,
@@ -118,12 +122,12 @@ pub fn run(args: &RobustnessArgs) -> anyhow::Result<()> {
     let n = args.model.joint_count()?;
     eigenmpc::with_joint_count!(
         n,
-        |N, S, NP| run_for::<N, S, NP>(args),
+        |N, S, NP, NA| run_for::<N, S, NP, NA>(args),
         otherwise Err(anyhow::anyhow!(eigenmpc::joints::unsupported(n)))
     )
 }
 
-fn run_for<const N: usize, const S: usize, const NP: usize>(
+fn run_for<const N: usize, const S: usize, const NP: usize, const NA: usize>(
     args: &RobustnessArgs,
 ) -> anyhow::Result<()> {
     if !(args.duration.is_finite() && args.duration > 5.0) {
@@ -144,6 +148,9 @@ fn run_for<const N: usize, const S: usize, const NP: usize>(
         .map_err(anyhow::Error::msg)?;
     setup.ekf = args.ekf;
     setup.declared = !args.undeclared;
+    setup.settings.adapt_estimator = eigenmpc_fmu_models::enums::ADAPT_ESTIMATOR
+        .named(&args.adapt_estimator)
+        .map_err(anyhow::Error::msg)?;
     // Refuse a configuration the controller cannot build before the sweep.
     setup.settings.build::<S>().map_err(anyhow::Error::msg)?;
     let sweep = Sweep {
@@ -185,7 +192,7 @@ fn run_for<const N: usize, const S: usize, const NP: usize>(
     let outcomes: Vec<_> = pool.install(|| {
         jobs.par_iter()
             .progress_with(bar.clone())
-            .map(|&(i, adapt)| run_case::<N, S, NP>(&setup, &cases[i], 1 + i as u64, adapt))
+            .map(|&(i, adapt)| run_case::<N, S, NP, NA>(&setup, &cases[i], 1 + i as u64, adapt))
             .collect()
     });
     bar.finish_and_clear();
@@ -200,7 +207,7 @@ fn run_for<const N: usize, const S: usize, const NP: usize>(
         });
     }
     let title = format!(
-        "# EigenMPC robustness v2: curved, E_ref = {} J, |tau| <= {} N m, N = {}, dt = {} s, {} s per run, every joint from {} rad at rest; model {}{}\n\n{}",
+        "# EigenMPC robustness v2: curved, E_ref = {} J, |tau| <= {} N m, N = {}, dt = {} s, {} s per run, every joint from {} rad at rest; model {}{}{}\n\n{}",
         args.energy,
         args.tau_max,
         setup.settings.horizon,
@@ -217,6 +224,14 @@ fn run_for<const N: usize, const S: usize, const NP: usize>(
             "; state estimator: EKF in every case, told the case's measurement noise"
         } else {
             "; state estimator: EKF where the sensors are noisy"
+        },
+        if args.adapt_estimator == "energy_balance" {
+            String::new()
+        } else {
+            format!(
+                "; adaptation's candidates: {} (adapt_estimator)",
+                args.adapt_estimator
+            )
         },
         definitions(sweep, setup.declared),
     );

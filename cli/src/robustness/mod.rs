@@ -26,7 +26,6 @@
 
 pub mod report;
 
-use eigenmpc::adapt::Adaptation;
 use eigenmpc::mechanics::{PlanarChain, PlanarChainParams, Vector};
 use eigenmpc::mpc::Variant;
 use eigenmpc::mpc::closed_loop::{
@@ -617,9 +616,10 @@ fn rms_tail<const N: usize, const S: usize>(
 /// Runs one case, with or without adaptation (synchronous: the numbers do
 /// not depend on the machine). A case whose plant or controller cannot be
 /// built, or whose integration fails, is an error.
-/// `S = 2 N` and `NP` (the chain's base parameters) as
-/// [`eigenmpc::with_joint_count`] binds them.
-pub fn run_case<const N: usize, const S: usize, const NP: usize>(
+/// `S = 2 N`, `NP` (the chain's base parameters) and `NA = S + NP` as
+/// [`eigenmpc::with_joint_count`] binds them; the adaptation's source is
+/// `setup.settings.adapt_estimator`.
+pub fn run_case<const N: usize, const S: usize, const NP: usize, const NA: usize>(
     setup: &Setup<N>,
     case: &Case,
     seed: u64,
@@ -652,10 +652,7 @@ pub fn run_case<const N: usize, const S: usize, const NP: usize>(
     }
     let mut controller = settings.build::<S>()?;
     let mut adaptation = if adapt {
-        Some(
-            Adaptation::<N, S, NP>::new(&settings.model.params(), settings.adapt_options())
-                .map_err(|e| e.to_string())?,
-        )
+        Some(settings.adaptation::<S, NP, NA>(&settings.model.params())?)
     } else {
         None
     };
@@ -950,7 +947,7 @@ mod tests {
             unit: "model",
             perturbation: Perturbation::RoughModelNoisy(1),
         };
-        let out = run_case::<2, 4, 11>(&setup, &case, 1, true).unwrap();
+        let out = run_case::<2, 4, 11, 15>(&setup, &case, 1, true).unwrap();
         assert!(
             out.energy_error.abs() < 0.02,
             "energy error {:.4}",
@@ -971,6 +968,11 @@ mod tests {
     fn rough_models_are_seeded_and_bounded() {
         let nominal = lab_a0();
         let a = rough_model(&nominal, 3);
+        // Pinned: tests/python/test_controller.py generates the same models.
+        assert_eq!(
+            rough_model(&nominal, 0).links[0].mass / nominal.links[0].mass,
+            0.8379975512711284
+        );
         assert_eq!(a, rough_model(&nominal, 3));
         assert_ne!(a, rough_model(&nominal, 4));
         for (r, n) in a.links.iter().zip(&nominal.links) {

@@ -12,9 +12,9 @@ use eigenmpc::mpc::{ControlOutput, ControllerState};
 use nalgebra::SVector;
 
 /// An `N`-joint controller (`NX = 2 N`, `NP` =
-/// [`eigenmpc::identify::base_parameter_count`]`(N)`) and, with `adapt`,
-/// the identification its model follows.
-pub struct AdaptiveController<const N: usize, const NX: usize, const NP: usize> {
+/// [`eigenmpc::identify::base_parameter_count`]`(N)`, `NA = NX + NP`) and,
+/// with `adapt`, the identification its model follows.
+pub struct AdaptiveController<const N: usize, const NX: usize, const NP: usize, const NA: usize> {
     controller: ChainController<N, NX>,
     adaptation: Option<Adaptation<N, NX, NP>>,
     /// Base parameters of the model the controller was built with (None:
@@ -22,7 +22,9 @@ pub struct AdaptiveController<const N: usize, const NX: usize, const NP: usize> 
     prior: Option<BaseParameters<N, NP>>,
 }
 
-impl<const N: usize, const NX: usize, const NP: usize> AdaptiveController<N, NX, NP> {
+impl<const N: usize, const NX: usize, const NP: usize, const NA: usize>
+    AdaptiveController<N, NX, NP, NA>
+{
     /// Builds the controller of `settings` and, with `adapt`, its
     /// adaptation (refused for a model with joint springs: its energy is
     /// not linear in the base parameters). Set-up: allocates, may take tens
@@ -42,10 +44,7 @@ impl<const N: usize, const NX: usize, const NP: usize> AdaptiveController<N, NX,
         let params = *controller.system().params();
         let prior = BaseParameters::<N, NP>::of(&params).ok();
         let adaptation = if settings.adapt {
-            Some(
-                Adaptation::new(&params, settings.adapt_options())
-                    .map_err(|e| format!("adapt = true: {e}"))?,
-            )
+            Some(settings.adaptation::<NX, NP, NA>(&params)?)
         } else {
             None
         };

@@ -122,8 +122,8 @@ impl<const N: usize> Io<N> {
 
 /// The EigenMPC controller FMU model for `N` joints (`NX = 2 N`, `NP` =
 /// [`eigenmpc::identify::base_parameter_count`]`(N)` base parameters).
-pub struct ControllerFmu<P, const N: usize, const NX: usize, const NP: usize> {
-    controller: AdaptiveController<N, NX, NP>,
+pub struct ControllerFmu<P, const N: usize, const NX: usize, const NP: usize, const NA: usize> {
+    controller: AdaptiveController<N, NX, NP, NA>,
     /// Time of the last solve (the adaptation's sample interval).
     solved_at: f64,
     /// Model updates already reported.
@@ -197,8 +197,13 @@ pub fn description_with<const N: usize>(
     }
 }
 
-impl<P: ControllerProduct<N> + Send, const N: usize, const NX: usize, const NP: usize>
-    ControllerFmu<P, N, NX, NP>
+impl<
+    P: ControllerProduct<N> + Send,
+    const N: usize,
+    const NX: usize,
+    const NP: usize,
+    const NA: usize,
+> ControllerFmu<P, N, NX, NP, NA>
 {
     /// `fmi2ExitInitializationMode` with `defaults` under the values (an
     /// exported robot's start values; the product's otherwise) and a mode
@@ -272,8 +277,13 @@ impl<P: ControllerProduct<N> + Send, const N: usize, const NX: usize, const NP: 
     }
 }
 
-impl<P: ControllerProduct<N> + Send, const N: usize, const NX: usize, const NP: usize> Model
-    for ControllerFmu<P, N, NX, NP>
+impl<
+    P: ControllerProduct<N> + Send,
+    const N: usize,
+    const NX: usize,
+    const NP: usize,
+    const NA: usize,
+> Model for ControllerFmu<P, N, NX, NP, NA>
 {
     fn description() -> ModelDescription {
         description::<P, N>()
@@ -362,7 +372,9 @@ impl<P: ControllerProduct<N> + Send, const N: usize, const NX: usize, const NP: 
     }
 }
 
-impl<P, const N: usize, const NX: usize, const NP: usize> ControllerFmu<P, N, NX, NP> {
+impl<P, const N: usize, const NX: usize, const NP: usize, const NA: usize>
+    ControllerFmu<P, N, NX, NP, NA>
+{
     fn inputs(&self, values: &Values) -> SVector<f64, NX> {
         SVector::from_fn(|i, _| {
             if i < N {
@@ -555,7 +567,7 @@ impl<P, const N: usize, const NX: usize, const NP: usize> ControllerFmu<P, N, NX
     }
 
     /// The controller with its adaptation.
-    pub fn adaptive(&self) -> &AdaptiveController<N, NX, NP> {
+    pub fn adaptive(&self) -> &AdaptiveController<N, NX, NP, NA> {
         &self.controller
     }
 

@@ -4,14 +4,15 @@
 
 use super::precomputed::PrecomputedFamily;
 use crate::chain::{ChainParameters, HasChain};
-use eigenmpc::adapt::AdaptOptions;
+use eigenmpc::adapt::{AdaptOptions, Adaptation};
 use eigenmpc::identify::RlsOptions;
-use eigenmpc::mechanics::{MechanicalSystem, PlanarChain, Vector};
+use eigenmpc::mechanics::{MechanicalSystem, PlanarChain, PlanarChainParams, Vector};
 use eigenmpc::modes::{Chart, ChartFamily, FamilyOptions, linear_modes};
 use eigenmpc::mpc::{
     Controller, CostParams, EstimatorConfig, Guide, MpcConfig, PREDICTION_SUBSTEPS, QpBackend,
     Reference, Variant, Weights, prediction_model,
 };
+use eigenmpc::state_parameter_ekf::{StateParameterEkf, StateParameterOptions};
 
 /// Longest horizon the clarabel QP backend is offered for.
 pub const CLARABEL_MAX_HORIZON: usize = 200;
@@ -110,6 +111,18 @@ pub enum StateEstimator {
     Ekf,
 }
 
+/// Where the online adaptation's candidate models come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AdaptEstimator {
+    /// The energy balance over windows (recursive least squares,
+    /// [`eigenmpc::identify::EnergyBalanceRls`]).
+    EnergyBalance,
+    /// The state and the base parameters estimated together every sample
+    /// ([`eigenmpc::state_parameter_ekf::StateParameterEkf`]), the loop
+    /// excited while it learns ([`AdaptOptions::excitation`]).
+    StateAndParameters,
+}
+
 /// One controller's full definition.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Settings<const N: usize> {
@@ -150,6 +163,8 @@ pub struct Settings<const N: usize> {
     /// Time between two looks at the estimate (s): a new model is taken
     /// or requested at most this often.
     pub adapt_period: f64,
+    /// Where the adaptation's candidates come from.
+    pub adapt_estimator: AdaptEstimator,
     /// Real-time adaptation: a sample never waits for the worker thread's
     /// new model (it is taken at the first look after it is ready, so the
     /// closed loop depends on the machine's speed). Off: the next look
@@ -213,6 +228,7 @@ impl<const N: usize> Settings<N> {
             },
             adapt: false,
             adapt_period: 1.0,
+            adapt_estimator: AdaptEstimator::EnergyBalance,
             adapt_realtime: false,
             measurement_delay: config.measurement_delay,
             actuator_time_constant: config.actuator_time_constant,
@@ -229,6 +245,44 @@ impl<const N: usize> Settings<N> {
             synchronous: !self.adapt_realtime,
             rls: self.rls_options(),
             ..AdaptOptions::default()
+        }
+    }
+
+    /// The online adaptation of a controller whose model is `prior`, with
+    /// the filter of [`AdaptEstimator::StateAndParameters`] when set
+    /// (`NX = 2 N`, `NP` = the base parameters, `NA = NX + NP`). Set-up:
+    /// allocates and starts the worker thread.
+    pub fn adaptation<const NX: usize, const NP: usize, const NA: usize>(
+        &self,
+        prior: &PlanarChainParams<N>,
+    ) -> Result<Adaptation<N, NX, NP>, String> {
+        let mut adaptation = Adaptation::new(prior, self.adapt_options())
+            .map_err(|e| format!("adapt = true: {e}"))?;
+        if self.adapt_estimator == AdaptEstimator::StateAndParameters {
+            let filter = StateParameterEkf::<N, NX, NP, NA>::new(
+                prior,
+                self.filter_options(),
+                self.sample_period,
+            )
+            .map_err(|e| format!("adapt_estimator = state_and_parameters: {e}"))?;
+            adaptation.set_filter(Box::new(filter));
+        }
+        Ok(adaptation)
+    }
+
+    /// The state and parameter filter's settings
+    /// ([`AdaptEstimator::StateAndParameters`]): the sensors' noise as the
+    /// state estimator is told it, else the laboratory robots' (0.005 rad,
+    /// 0.05 rad/s).
+    pub fn filter_options(&self) -> StateParameterOptions {
+        let options = StateParameterOptions::default();
+        match self.state_estimator {
+            StateEstimator::None => options,
+            StateEstimator::Ekf => StateParameterOptions {
+                angle_noise: self.noise.angle_noise,
+                speed_noise: self.noise.speed_noise,
+                ..options
+            },
         }
     }
 

@@ -21,7 +21,9 @@
 
 use super::settings::{CHART_COEFFICIENTS, Settings};
 use crate::chain::{point_mass_rows, rigid_rows};
-use crate::enums::{ADAPTATION_STATUS, CHART_SOURCE, QP_SOLVER, STATE_ESTIMATOR, VARIANT};
+use crate::enums::{
+    ADAPT_ESTIMATOR, ADAPTATION_STATUS, CHART_SOURCE, QP_SOLVER, STATE_ESTIMATOR, VARIANT,
+};
 use fmi2_slave::table::{Deps, Field, Row, Shape, Table};
 
 /// Group tag of the reference rows (`E_ref`, `c[j]`, `chart.coef[j,k]`),
@@ -257,6 +259,7 @@ pub fn table<const N: usize>() -> Table<Settings<N>> {
     rows.extend(adaptation_outcome_rows::<N>());
     rows.extend(supervisor_rows::<N>());
     rows.extend(response_rows::<N>());
+    rows.extend(adapt_estimator_rows::<N>());
     Table::new(N, rows)
 }
 
@@ -548,6 +551,33 @@ fn estimator_rows<const N: usize>() -> Vec<Rw<N>> {
 
 /// The motor's response per sample (issue 37; after the supervisor's rows:
 /// the older value references stay).
+/// Where the adaptation's candidates come from (after the older rows:
+/// their value references stay).
+fn adapt_estimator_rows<const N: usize>() -> Vec<Rw<N>> {
+    vec![
+        Rw::<N>::enumeration(
+            ADAPT_ESTIMATOR.parameter,
+            Shape::Scalar,
+            ADAPT_ESTIMATOR.fmi_type(),
+        )
+        .parameter(Field::integer(
+            |s, _| ADAPT_ESTIMATOR.item(s.adapt_estimator),
+            |s, _, v| s.adapt_estimator = ADAPT_ESTIMATOR.value(v).unwrap_or(s.adapt_estimator),
+        ))
+        .describe(
+            "Adaptation (adapt = true): where candidate models come from. energy_balance: the \
+             energy balance over windows. state_and_parameters: the state and the base \
+             parameters estimated together every sample by an extended Kalman filter told the \
+             sensors' noise (angle_noise, speed_noise with state_estimator = ekf; else 0.005 \
+             rad, 0.05 rad/s), and the torque carrying a Gaussian excitation of 0.3 tau_max \
+             per joint over the first 40 s (adaptation_status = excitation), without which \
+             closed-loop data cannot tell the model's scale from its friction. Under sensor \
+             noise with a rough model it is the one that reaches the mode (the lab pendulums' \
+             rough models: 41 of 42 within 2 %, against 27 of 42)",
+        ),
+    ]
+}
+
 fn response_rows<const N: usize>() -> Vec<Rw<N>> {
     vec![
         Rw::<N>::real("torque_response", Shape::Scalar)
