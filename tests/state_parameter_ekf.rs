@@ -8,6 +8,7 @@ mod rough_model;
 use eigenmpc::adapt::{AdaptOptions, Adaptation};
 use eigenmpc::identify::{BaseParameters, EnergyBalanceRls, RlsOptions};
 use eigenmpc::integrate::{Dopri5, Tolerances};
+use eigenmpc::math;
 use eigenmpc::mechanics::{PlanarChain, PlanarChainParams, Vector, state_derivative};
 use eigenmpc::model_file::RobotFile;
 use eigenmpc::modes::{ChartFamily, FamilyOptions};
@@ -235,6 +236,49 @@ fn bad_input_is_refused_or_skipped() {
     assert!(!ekf.step(&z, &Vector::<2>::new(f64::INFINITY, 0.0)));
     assert_eq!((ekf.state(), ekf.parameters()), before);
     assert_eq!(ekf.restarts(), 0);
+}
+
+/// A saved filter continues bit for bit in a fresh one (the FMU's saved
+/// state); a state of another size is refused and changes nothing.
+#[test]
+fn a_saved_filter_continues_bit_for_bit() {
+    let plant = robot_a0();
+    let options = StateParameterOptions::default();
+    let mut noise = GaussianNoise::new(5);
+    let measured: Vec<SVector<f64, 4>> = (0..80)
+        .map(|k| {
+            let t = k as f64 * 0.025;
+            let z = SVector::<f64, 4>::new(
+                0.3 * math::sin(t),
+                0.2 * math::cos(t),
+                0.3 * math::cos(t),
+                -0.2 * math::sin(t),
+            );
+            noise.measure(&z, 0.005, 0.05)
+        })
+        .collect();
+    let torque = |k: usize| probing_torque(k as f64 * 0.025);
+    let mut first = StateParameterEkf::<2, 4, 11, 15>::new(&plant, options, 0.025).unwrap();
+    for (k, z) in measured[..40].iter().enumerate() {
+        first.step(z, &torque(k));
+    }
+    let saved = first.save_state();
+    let mut second = StateParameterEkf::<2, 4, 11, 15>::new(&plant, options, 0.025).unwrap();
+    second.restore_state(&saved).unwrap();
+    for (k, z) in measured.iter().enumerate().skip(40) {
+        first.step(z, &torque(k));
+        second.step(z, &torque(k));
+    }
+    assert_eq!(first.state(), second.state());
+    assert_eq!(first.parameters(), second.parameters());
+    assert_eq!(first.parameter_covariance(), second.parameter_covariance());
+    // A three-joint filter's state does not fit a two-joint one.
+    let three = PlanarChainParams::<3>::default();
+    let other = StateParameterEkf::<3, 6, 18, 24>::new(&three, options, 0.025).unwrap();
+    let before = second.save_state();
+    let e = second.restore_state(&other.save_state()).unwrap_err();
+    assert!(e.contains("for 15"), "{e}");
+    assert_eq!(second.save_state(), before);
 }
 
 /// The lab pendulum B0 from its own model (friction known), in closed loop
