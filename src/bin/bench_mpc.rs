@@ -28,6 +28,7 @@ use eigenmpc::mpc::closed_loop::{
 };
 use eigenmpc::mpc::{Controller, MpcConfig, QpBackend, Variant};
 use eigenmpc::robustness::{Imperfections, run_imperfect};
+use eigenmpc::state_parameter_ekf::{StateParameterEkf, StateParameterOptions};
 use nalgebra::SVector;
 
 fn stats(mut v: Vec<f64>) -> [f64; 4] {
@@ -435,7 +436,9 @@ fn adaptation_table(duration: f64) {
     plant_params.joints[1].viscous = 0.05;
     let plant = PlanarChain::new(plant_params).expect("plant");
     let prior = PlanarChainParams::<2>::default();
-    for adapt in [false, true] {
+    // Off; on with the energy balance; on with the state and parameters
+    // estimated together (its excitation over the first 40 s).
+    for (adapt, filtered) in [(false, false), (true, false), (true, true)] {
         let model = PlanarChain::new(prior).expect("model");
         let family =
             ChartFamily::compute::<_, 4>(&model, 0, &FamilyOptions::for_system(&model, &[14.0]))
@@ -444,6 +447,15 @@ fn adaptation_table(duration: f64) {
         let mut ctrl = Controller::<_, 2, 4>::with_family(model, config, family).expect("ctrl");
         let mut adaptation =
             Adaptation::<2, 4, 11>::new(&prior, AdaptOptions::default()).expect("adaptation");
+        if filtered {
+            let filter = StateParameterEkf::<2, 4, 11, 15>::new(
+                &prior,
+                StateParameterOptions::default(),
+                config.dt,
+            )
+            .expect("filter");
+            adaptation.set_filter(Box::new(filter));
+        }
         let z0 = SVector::<f64, 4>::new(0.05, 0.05, 0.0, 0.0);
         let run = run_imperfect(
             &mut ctrl,
@@ -466,7 +478,11 @@ fn adaptation_table(duration: f64) {
             .zip(adapt_time)
             .map(|(s, a)| s.solve_time + a)
             .collect();
-        let label = if adapt { "on" } else { "off" };
+        let label = match (adapt, filtered) {
+            (false, _) => "off",
+            (true, false) => "on",
+            (true, true) => "on, state and parameters",
+        };
         let energy = run.samples.last().map_or(f64::NAN, |s| s.energy);
         if adapt {
             println!(
